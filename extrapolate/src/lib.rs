@@ -1,0 +1,1 @@
+//! Pairing of the t0/t1 snapshots and replay of a recorded collision table (DESIGN.md §5–6; issue 4, not built yet).

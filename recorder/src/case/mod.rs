@@ -1,0 +1,70 @@
+//! Case files: the TOML schema, loading with errors that name the file and field, and validation.
+
+mod schema;
+mod validate;
+
+pub use schema::*;
+pub use validate::{rayleigh_time, validate, MAX_FILL_FRACTION, MAX_RAYLEIGH_FRACTION};
+
+use std::path::{Path, PathBuf};
+
+/// Why a case file was refused. Every message names the file; `Invalid` also names the
+/// field, the offending value and what is allowed.
+#[derive(Debug, thiserror::Error)]
+pub enum CaseError {
+    #[error("cannot read case file {}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: not a valid case file: {message}", path.display())]
+    Parse { path: PathBuf, message: String },
+    #[error("{}: {field} = {value} is not allowed: {limit}", path.display())]
+    Invalid {
+        path: PathBuf,
+        field: String,
+        value: String,
+        limit: String,
+    },
+}
+
+/// Reads, parses and validates a case file.
+pub fn load(path: &Path) -> Result<Case, CaseError> {
+    let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&text, path)
+}
+
+/// Parses and validates case text; `path` is only used in messages.
+pub fn parse(text: &str, path: &Path) -> Result<Case, CaseError> {
+    let case: Case = toml::from_str(text).map_err(|e| CaseError::Parse {
+        path: path.to_path_buf(),
+        message: e.to_string().trim_end().to_string(),
+    })?;
+    validate(&case).map_err(|v| CaseError::Invalid {
+        path: path.to_path_buf(),
+        field: v.field,
+        value: v.value,
+        limit: v.limit,
+    })?;
+    Ok(case)
+}
+
+impl Case {
+    /// Heating time of `tdex run`: the case's, or one revolution.
+    pub fn heating_time(&self) -> f64 {
+        self.time.heating.unwrap_or(self.drum.rotation_period)
+    }
+
+    /// Drum angular velocity (rad/s) about +y.
+    pub fn angular_velocity(&self) -> f64 {
+        2.0 * std::f64::consts::PI / self.drum.rotation_period
+    }
+
+    /// Number of DEM steps in `seconds`, rounded to the nearest step.
+    pub fn steps_in(&self, seconds: f64) -> u64 {
+        (seconds / self.time.dt).round() as u64
+    }
+}

@@ -1,0 +1,205 @@
+//! The TOML case file as the user writes it (serde schema; unknown keys refused).
+
+use serde::{Deserialize, Serialize};
+
+/// A rotating-drum thermal DEM case, exactly as read from a `.toml` file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Free-form name, used in reports.
+    #[serde(default)]
+    pub name: String,
+    /// Seed of every random choice (insertion); same case + seed give the same bytes.
+    pub seed: u64,
+    pub particles: ParticlesSpec,
+    pub material: Material,
+    pub contact: ContactSpec,
+    #[serde(default)]
+    pub conduction: ConductionSpec,
+    pub drum: Drum,
+    pub time: TimeSpec,
+    pub temperature: TemperatureSpec,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticlesSpec {
+    /// Number of spheres.
+    pub count: usize,
+    /// Sphere radius (m); monodisperse for now.
+    pub radius: f64,
+}
+
+/// Bulk properties of the particle material (the drum wall shares the elastic ones).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// kg/m³
+    pub density: f64,
+    /// Young's modulus used by the contact law (Pa); often softened.
+    pub youngs_modulus: f64,
+    /// Poisson's ratio, in [0, 0.5).
+    pub poisson_ratio: f64,
+    /// W/(m K)
+    pub conductivity: f64,
+    /// Specific heat capacity, J/(kg K)
+    pub heat_capacity: f64,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContactSpec {
+    /// Rolling resistance model, as LIGGGHTS `rolling_friction`.
+    #[serde(default)]
+    pub rolling_model: RollingModel,
+    pub particle_particle: PairCoefficients,
+    pub particle_wall: PairCoefficients,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PairCoefficients {
+    /// Coefficient of restitution, in (0, 1].
+    pub restitution: f64,
+    /// Coulomb sliding friction coefficient, ≥ 0.
+    pub friction: f64,
+    /// Rolling friction coefficient μr, ≥ 0.
+    #[serde(default)]
+    pub rolling_friction: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RollingModel {
+    /// Elastic–plastic spring-dashpot without dashpot (LIGGGHTS `epsd2`).
+    #[default]
+    Epsd2,
+    /// Constant directional torque (LIGGGHTS `cdt`).
+    Cdt,
+    /// No rolling resistance.
+    Off,
+}
+
+/// Particle–particle (and heated-wall) conduction options, LIGGGHTS `heat/gran/conduction`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ConductionSpec {
+    /// Which contact area enters `H = 4KiKj/(Ki+Kj)·sqrt(A)`.
+    #[serde(default)]
+    pub contact_area: ContactArea,
+    /// Real Young's modulus (Pa) of the material: when set, the overlap is corrected by
+    /// `(E*/E*_real)^(2/3)` before the area is computed (LIGGGHTS `area_correction yes`).
+    #[serde(default)]
+    pub youngs_modulus_real: Option<f64>,
+}
+
+impl Default for ConductionSpec {
+    fn default() -> Self {
+        Self {
+            contact_area: ContactArea::Overlap,
+            youngs_modulus_real: None,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ContactArea {
+    /// The sphere–sphere intersection disc (LIGGGHTS default `contact_area overlap`).
+    #[default]
+    Overlap,
+    /// The Hertz contact circle `π R* δ`.
+    Hertz,
+}
+
+/// A horizontal drum, axis `y` through the origin, gravity `-z`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Drum {
+    /// Inner radius of the mantle (m).
+    pub radius: f64,
+    /// Inner length between the end caps (m).
+    pub length: f64,
+    /// Seconds per revolution, counter-clockwise seen from +y (z → x).
+    pub rotation_period: f64,
+    /// Whether the flat end caps turn with the mantle or stand still.
+    #[serde(default)]
+    pub end_caps: EndCaps,
+    /// When set, the mantle is held at this temperature (K) from `t0` on and conducts
+    /// to the particles touching it; the end caps stay adiabatic.
+    #[serde(default)]
+    pub wall_temperature: Option<f64>,
+    /// Conductivity of the heated mantle (W/(m K)); defaults to the particles'.
+    #[serde(default)]
+    pub wall_conductivity: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum EndCaps {
+    /// The caps are part of the drum and rotate with it (LIGGGHTS: one rotating mesh).
+    #[default]
+    Rotating,
+    /// The caps are fixed (a kiln's stationary hoods).
+    Fixed,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// DEM time step (s); refused above `MAX_RAYLEIGH_FRACTION` of the Rayleigh time.
+    pub dt: f64,
+    /// Settling time with the drum at rest after insertion (s).
+    pub settle: f64,
+    /// Rotation before the temperatures are assigned at `t0` (s).
+    pub spin_up: f64,
+    /// Heating time simulated by `tdex run` after `t0` (s); default one revolution.
+    #[serde(default)]
+    pub heating: Option<f64>,
+}
+
+/// Initial temperatures assigned at `t0`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TemperatureSpec {
+    pub mode: TemperatureMode,
+    /// `split`: temperature of the hot half (K).
+    #[serde(default)]
+    pub hot: Option<f64>,
+    /// `split`: temperature of the cold half (K).
+    #[serde(default)]
+    pub cold: Option<f64>,
+    /// `split`: the axis across which the bed is split; the half with the smaller
+    /// coordinate is hot. The plane is placed so that exactly ⌊N/2⌋ particles are hot.
+    #[serde(default)]
+    pub split_axis: Axis,
+    /// `uniform`: the temperature of every particle (K).
+    #[serde(default)]
+    pub value: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum TemperatureMode {
+    Split,
+    Uniform,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Axis {
+    #[default]
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}

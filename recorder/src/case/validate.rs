@@ -1,0 +1,227 @@
+//! Physical validation of a parsed case: every refusal names the field, the value and the limit.
+
+use super::schema::*;
+use crate::insertion;
+
+/// The largest accepted `dt` as a fraction of the Rayleigh time (the paper runs at 23 %;
+/// 10–30 % is common DEM practice).
+pub const MAX_RAYLEIGH_FRACTION: f64 = 0.30;
+/// Largest accepted bed volume (at the random-loose packing 0.6) as a fraction of the drum.
+pub const MAX_FILL_FRACTION: f64 = 0.90;
+/// Packing fraction used to size the settled bed.
+const BED_PACKING: f64 = 0.60;
+
+/// A refused value, before the file name is attached.
+#[derive(Debug)]
+pub struct Violation {
+    pub field: String,
+    pub value: String,
+    pub limit: String,
+}
+
+fn refuse(field: &str, value: impl std::fmt::Display, limit: impl Into<String>) -> Violation {
+    Violation {
+        field: field.to_string(),
+        value: value.to_string(),
+        limit: limit.into(),
+    }
+}
+
+fn positive(field: &str, v: f64) -> Result<(), Violation> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(refuse(field, v, "must be a finite number > 0"))
+    }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<(), Violation> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(refuse(field, v, "must be a finite number >= 0"))
+    }
+}
+
+/// Rayleigh time `π R sqrt(ρ/G)/(0.1631ν + 0.8766)` of a sphere, `G = E/(2(1+ν))`.
+pub fn rayleigh_time(radius: f64, density: f64, youngs_modulus: f64, poisson_ratio: f64) -> f64 {
+    let shear_modulus = youngs_modulus / (2.0 * (1.0 + poisson_ratio));
+    std::f64::consts::PI * radius * (density / shear_modulus).sqrt()
+        / (0.1631 * poisson_ratio + 0.8766)
+}
+
+fn pair(prefix: &str, c: &PairCoefficients) -> Result<(), Violation> {
+    let e = c.restitution;
+    if !(e.is_finite() && e > 0.0 && e <= 1.0) {
+        return Err(refuse(
+            &format!("{prefix}.restitution"),
+            e,
+            "must lie in (0, 1]",
+        ));
+    }
+    non_negative(&format!("{prefix}.friction"), c.friction)?;
+    non_negative(&format!("{prefix}.rolling_friction"), c.rolling_friction)
+}
+
+/// Checks every value of the case against its physical range.
+pub fn validate(case: &Case) -> Result<(), Violation> {
+    let p = &case.particles;
+    if p.count < 2 {
+        return Err(refuse("particles.count", p.count, "must be at least 2"));
+    }
+    if p.count > u32::MAX as usize / 2 {
+        return Err(refuse(
+            "particles.count",
+            p.count,
+            format!("must be at most {}", u32::MAX / 2),
+        ));
+    }
+    positive("particles.radius", p.radius)?;
+
+    let m = &case.material;
+    positive("material.density", m.density)?;
+    positive("material.youngs_modulus", m.youngs_modulus)?;
+    let nu = m.poisson_ratio;
+    if !(nu.is_finite() && (0.0..0.5).contains(&nu)) {
+        return Err(refuse("material.poisson_ratio", nu, "must lie in [0, 0.5)"));
+    }
+    positive("material.conductivity", m.conductivity)?;
+    positive("material.heat_capacity", m.heat_capacity)?;
+
+    pair("contact.particle_particle", &case.contact.particle_particle)?;
+    pair("contact.particle_wall", &case.contact.particle_wall)?;
+
+    if let Some(e_real) = case.conduction.youngs_modulus_real {
+        positive("conduction.youngs_modulus_real", e_real)?;
+        if e_real < m.youngs_modulus {
+            return Err(refuse(
+                "conduction.youngs_modulus_real",
+                e_real,
+                format!(
+                    "must be >= material.youngs_modulus = {} (the contact modulus is a softened real one)",
+                    m.youngs_modulus
+                ),
+            ));
+        }
+    }
+
+    let d = &case.drum;
+    positive("drum.radius", d.radius)?;
+    positive("drum.length", d.length)?;
+    if d.radius <= 2.0 * p.radius {
+        return Err(refuse(
+            "drum.radius",
+            d.radius,
+            format!("must exceed the particle diameter {}", 2.0 * p.radius),
+        ));
+    }
+    if d.length <= 2.0 * p.radius {
+        return Err(refuse(
+            "drum.length",
+            d.length,
+            format!("must exceed the particle diameter {}", 2.0 * p.radius),
+        ));
+    }
+    positive("drum.rotation_period", d.rotation_period)?;
+    if let Some(tw) = d.wall_temperature {
+        positive("drum.wall_temperature", tw)?;
+    }
+    if let Some(kw) = d.wall_conductivity {
+        positive("drum.wall_conductivity", kw)?;
+    }
+
+    let t = &case.time;
+    positive("time.dt", t.dt)?;
+    let t_rayleigh = rayleigh_time(p.radius, m.density, m.youngs_modulus, nu);
+    if t.dt > MAX_RAYLEIGH_FRACTION * t_rayleigh {
+        return Err(refuse(
+            "time.dt",
+            t.dt,
+            format!(
+                "must be <= {:.0} % of the Rayleigh time {:.4e} s, i.e. <= {:.4e} s (dt is {:.1} % of it)",
+                MAX_RAYLEIGH_FRACTION * 100.0,
+                t_rayleigh,
+                MAX_RAYLEIGH_FRACTION * t_rayleigh,
+                100.0 * t.dt / t_rayleigh
+            ),
+        ));
+    }
+    non_negative("time.settle", t.settle)?;
+    non_negative("time.spin_up", t.spin_up)?;
+    if let Some(h) = t.heating {
+        positive("time.heating", h)?;
+    }
+
+    let temp = &case.temperature;
+    match temp.mode {
+        TemperatureMode::Split => {
+            let hot = temp.hot.ok_or_else(|| {
+                refuse(
+                    "temperature.hot",
+                    "(missing)",
+                    "required when mode = \"split\"",
+                )
+            })?;
+            let cold = temp.cold.ok_or_else(|| {
+                refuse(
+                    "temperature.cold",
+                    "(missing)",
+                    "required when mode = \"split\"",
+                )
+            })?;
+            positive("temperature.hot", hot)?;
+            positive("temperature.cold", cold)?;
+            if temp.value.is_some() {
+                return Err(refuse(
+                    "temperature.value",
+                    temp.value.unwrap(),
+                    "only allowed when mode = \"uniform\"",
+                ));
+            }
+        }
+        TemperatureMode::Uniform => {
+            let v = temp.value.ok_or_else(|| {
+                refuse(
+                    "temperature.value",
+                    "(missing)",
+                    "required when mode = \"uniform\"",
+                )
+            })?;
+            positive("temperature.value", v)?;
+            if let Some(h) = temp.hot.or(temp.cold) {
+                return Err(refuse(
+                    "temperature.hot/cold",
+                    h,
+                    "only allowed when mode = \"split\"",
+                ));
+            }
+        }
+    }
+
+    // The settled bed must fit, and insertion must have room for every particle.
+    let particle_volume = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3);
+    let bed_volume = p.count as f64 * particle_volume / BED_PACKING;
+    let drum_volume = std::f64::consts::PI * d.radius * d.radius * d.length;
+    if bed_volume > MAX_FILL_FRACTION * drum_volume {
+        return Err(refuse(
+            "particles.count",
+            p.count,
+            format!(
+                "the bed ({:.3e} m³ at packing {BED_PACKING}) would fill {:.0} % of the drum ({:.3e} m³); at most {:.0} % is allowed",
+                bed_volume,
+                100.0 * bed_volume / drum_volume,
+                drum_volume,
+                MAX_FILL_FRACTION * 100.0
+            ),
+        ));
+    }
+    let sites = insertion::lattice_site_count(p.radius, d.radius, d.length);
+    if sites < p.count {
+        return Err(refuse(
+            "particles.count",
+            p.count,
+            format!("the drum has room for only {sites} particles on the insertion lattice"),
+        ));
+    }
+    Ok(())
+}

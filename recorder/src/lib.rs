@@ -1,0 +1,22 @@
+//! tdex recorder: case files, the thermal DEM engine of a rotating drum, and (to come) the
+//! collision recorder and its file format.
+//!
+//! Stages follow a DEM step: [`neighbor`] (cell grid, Verlet list), [`contact`] (one file per
+//! force law or pair kind), [`wall`], [`heat`] (conduction), [`integrate`], tied together by
+//! [`pipeline`]; [`counters`] times each stage. [`simulation`] drives a whole drum case.
+
+pub mod case;
+pub mod contact;
+pub mod counters;
+pub mod heat;
+pub mod insertion;
+pub mod integrate;
+pub mod math;
+pub mod neighbor;
+pub mod particles;
+pub mod pipeline;
+pub mod simulation;
+pub mod wall;
+
+pub use case::{Case, CaseError};
+pub use simulation::{Simulation, SimulationError};

@@ -1,0 +1,73 @@
+//! The particle set: one array per field (LAMMPS style), permuted together into cell order.
+
+/// Spheres of the simulation. Index `i` is the memory slot (changes at every re-sort);
+/// `id[i]` is the particle's permanent id.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ParticleSet {
+    pub id: Vec<u32>,
+    pub pos: Vec<[f64; 3]>,
+    pub vel: Vec<[f64; 3]>,
+    pub omega: Vec<[f64; 3]>,
+    pub force: Vec<[f64; 3]>,
+    pub torque: Vec<[f64; 3]>,
+    pub radius: Vec<f64>,
+    pub mass: Vec<f64>,
+    /// Temperature (K).
+    pub temp: Vec<f64>,
+    /// Heat flowing into the particle this step (W).
+    pub heat_flow: Vec<f64>,
+}
+
+impl ParticleSet {
+    pub fn len(&self) -> usize {
+        self.id.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.id.is_empty()
+    }
+
+    /// Adds a sphere at rest.
+    pub fn push(&mut self, id: u32, pos: [f64; 3], radius: f64, density: f64, temp: f64) {
+        self.id.push(id);
+        self.pos.push(pos);
+        self.vel.push([0.0; 3]);
+        self.omega.push([0.0; 3]);
+        self.force.push([0.0; 3]);
+        self.torque.push([0.0; 3]);
+        self.radius.push(radius);
+        self.mass
+            .push(density * 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3));
+        self.temp.push(temp);
+        self.heat_flow.push(0.0);
+    }
+
+    /// Reorders every field so that new slot `i` holds what old slot `order[i]` held.
+    pub fn permute(&mut self, order: &[u32]) {
+        permute_field(&mut self.id, order);
+        permute_field(&mut self.pos, order);
+        permute_field(&mut self.vel, order);
+        permute_field(&mut self.omega, order);
+        permute_field(&mut self.force, order);
+        permute_field(&mut self.torque, order);
+        permute_field(&mut self.radius, order);
+        permute_field(&mut self.mass, order);
+        permute_field(&mut self.temp, order);
+        permute_field(&mut self.heat_flow, order);
+    }
+
+    /// Slot of every id: `slot_of()[id] = i`.
+    pub fn slot_of(&self) -> Vec<u32> {
+        let mut slot = vec![u32::MAX; self.len()];
+        for (i, &id) in self.id.iter().enumerate() {
+            slot[id as usize] = i as u32;
+        }
+        slot
+    }
+}
+
+/// `field[i] = old[order[i]]`.
+pub fn permute_field<T: Copy>(field: &mut Vec<T>, order: &[u32]) {
+    let permuted: Vec<T> = order.iter().map(|&o| field[o as usize]).collect();
+    *field = permuted;
+}

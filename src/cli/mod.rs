@@ -1,0 +1,7 @@
+//! Flags as parsed (`args`) and the validated plan built from them before any work (`plan`).
+
+mod args;
+mod plan;
+
+pub use args::Cli;
+pub use plan::{Plan, RunPlan, UsageError};

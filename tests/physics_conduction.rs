@@ -1,0 +1,58 @@
+//! Two spheres held at a fixed overlap relax towards each other's temperature exponentially.
+
+use crate::util::*;
+use recorder::integrate::update_temperatures;
+use recorder::particles::ParticleSet;
+use recorder::pipeline::pair_interactions;
+
+#[test]
+fn pair_temperature_difference_decays_exponentially() {
+    let (ri, rj) = (0.005, 0.004);
+    let r = ri + rj - 2e-4; // centre distance: 0.2 mm overlap
+    let mut p = ParticleSet::default();
+    p.push(0, [0.0, 0.0, 0.0], ri, DENSITY, 30.0);
+    p.push(1, [r, 0.0, 0.0], rj, DENSITY, 10.0);
+    let (ci, cj) = (p.mass[0] * HEAT_CAPACITY, p.mass[1] * HEAT_CAPACITY);
+    // independent of the engine: the four-factor lens area and 2K sqrt(A)
+    let area =
+        -std::f64::consts::PI / 4.0 * (r - ri - rj) * (r + ri - rj) * (r - ri + rj) * (r + ri + rj)
+            / (r * r);
+    let h = 2.0 * CONDUCTIVITY * area.sqrt();
+    let rate = h * (1.0 / ci + 1.0 / cj);
+    // explicit Euler is (1 − c)^n against e^(−cn): 5 time constants cost 5c/2 relative
+    let dt = 2e-7 / rate;
+    let steps_per_tau = (1.0 / (rate * dt)).round() as u64;
+    let mut world = World::new(p, no_walls(), 0.5, dt, 0.0);
+    world
+        .neighbors
+        .rebuild(&mut world.particles, &world.pipeline.grid);
+    let (a, b) = if world.particles.id[0] == 0 {
+        (0, 1)
+    } else {
+        (1, 0)
+    };
+    let dt0 = 20.0;
+    let mut worst: f64 = 0.0;
+    with_threads(1, || {
+        for step in 1..=5 * steps_per_tau {
+            let touching =
+                pair_interactions(&world.params, &mut world.particles, &mut world.neighbors);
+            assert_eq!(touching, 2);
+            update_temperatures(&mut world.particles, dt, HEAT_CAPACITY);
+            if step % (steps_per_tau / 10) == 0 {
+                let t = step as f64 * dt;
+                let diff = world.particles.temp[a] - world.particles.temp[b];
+                let theory = dt0 * (-h * t * (1.0 / ci + 1.0 / cj)).exp();
+                worst = worst.max((diff / theory - 1.0).abs());
+            }
+        }
+    });
+    assert!(
+        worst < 1e-6,
+        "largest relative deviation from exp(-H t (1/Ci + 1/Cj)): {worst:.3e}"
+    );
+    // heat is exchanged, not created
+    let total = ci * world.particles.temp[a] + cj * world.particles.temp[b];
+    let start = ci * 30.0 + cj * 10.0;
+    assert!(((total - start) / start).abs() < 1e-12);
+}

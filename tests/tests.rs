@@ -1,0 +1,10 @@
+//! End-to-end and physics tests, compiled into one binary. Run in release mode:
+//! `cargo test --release --workspace`.
+
+mod util;
+
+mod cli_case_errors;
+mod cli_run;
+mod drum;
+mod physics_collision;
+mod physics_conduction;

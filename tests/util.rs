@@ -1,0 +1,112 @@
+//! Shared helpers: small worlds built straight from the engine's stages, and the CLI runner.
+
+use recorder::case::{ConductionSpec, PairCoefficients, RollingModel};
+use recorder::contact::PairLaw;
+use recorder::counters::Counters;
+use recorder::heat::ConductionLaw;
+use recorder::neighbor::{CellGrid, NeighborList};
+use recorder::particles::ParticleSet;
+use recorder::pipeline::{ContactCount, Pipeline, StepParams};
+use recorder::wall::WallSet;
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+pub const DENSITY: f64 = 2500.0;
+pub const YOUNG: f64 = 1.0e7;
+pub const POISSON: f64 = 0.3;
+pub const CONDUCTIVITY: f64 = 100.0;
+pub const HEAT_CAPACITY: f64 = 840.0;
+
+/// A few spheres and walls stepped by the real pipeline.
+pub struct World {
+    pub params: StepParams,
+    pub particles: ParticleSet,
+    pub neighbors: NeighborList,
+    pub walls: WallSet,
+    pub pipeline: Pipeline,
+    pub counters: Counters,
+}
+
+impl World {
+    pub fn new(
+        particles: ParticleSet,
+        walls: WallSet,
+        restitution: f64,
+        dt: f64,
+        gravity: f64,
+    ) -> Self {
+        let c = PairCoefficients {
+            restitution,
+            friction: 0.3,
+            rolling_friction: 0.002,
+        };
+        let law = PairLaw::new(YOUNG, POISSON, &c, RollingModel::Epsd2);
+        let params = StepParams {
+            dt,
+            gravity: [0.0, 0.0, -gravity],
+            particle_particle: law,
+            particle_wall: law,
+            conduction: ConductionLaw::new(
+                &ConductionSpec::default(),
+                CONDUCTIVITY,
+                CONDUCTIVITY,
+                HEAT_CAPACITY,
+                YOUNG,
+            ),
+        };
+        let rmax = particles.radius.iter().cloned().fold(0.0, f64::max);
+        let skin = 0.4 * rmax;
+        let grid = CellGrid::new([-0.1; 3], [0.1; 3], 2.0 * rmax + skin);
+        let neighbors = NeighborList::new(particles.len(), walls.len(), skin);
+        Self {
+            params,
+            particles,
+            neighbors,
+            walls,
+            pipeline: Pipeline::new(grid),
+            counters: Counters::default(),
+        }
+    }
+
+    pub fn step(&mut self) -> ContactCount {
+        self.pipeline.step(
+            &self.params,
+            &mut self.particles,
+            &mut self.neighbors,
+            &self.walls,
+            &mut self.counters,
+        )
+    }
+}
+
+pub fn no_walls() -> WallSet {
+    WallSet {
+        walls: Vec::new(),
+        angular_velocity: 0.0,
+        mantle_temperature: None,
+    }
+}
+
+pub fn tdex() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_tdex"))
+}
+
+pub fn repo() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn run_tdex(args: &[&str]) -> Output {
+    std::process::Command::new(tdex())
+        .args(args)
+        .output()
+        .expect("tdex starts")
+}
+
+/// Runs `f` on a pool of `threads` workers.
+pub fn with_threads<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
