@@ -30,6 +30,12 @@ fn drum_heating_for_one_revolution_conserves_heat_and_mixes() {
         .unwrap();
     let end = sim.heat_summary();
     let drift = ((end.total_heat - start.total_heat) / start.total_heat).abs();
+    eprintln!(
+        "one revolution: heat drift {drift:.3e}, hot {:.4} K, cold {:.4} K, {:.2} contacts/particle",
+        end.hot_mean.unwrap(),
+        end.cold_mean.unwrap(),
+        sim.contacts_per_particle()
+    );
     assert!(drift < 1e-12, "sum m c T drifted by {drift:.3e}");
     let (hot, cold) = (end.hot_mean.unwrap(), end.cold_mean.unwrap());
     assert!(hot < 30.0 - 0.1, "hot group mean {hot}");

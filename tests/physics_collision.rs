@@ -84,6 +84,11 @@ fn head_on_collision_matches_hertz_duration_and_restitution() {
         let (duration, e_measured, theory) = collide(e, 0.5);
         let dur_err = (duration - theory).abs() / theory;
         let e_err = (e_measured - e).abs() / e;
+        eprintln!(
+            "e = {e}: duration {duration:.5e} s, theory {theory:.5e} s ({:+.3} %), restitution {e_measured:.5} ({:+.3} %)",
+            100.0 * (duration / theory - 1.0),
+            100.0 * (e_measured / e - 1.0)
+        );
         assert!(
             dur_err < 0.02,
             "e = {e}: duration {duration:.6e} s vs theory {theory:.6e} s ({:.3} %)",
@@ -143,6 +148,10 @@ fn sphere_resting_on_a_flat_wall_has_the_hertz_static_overlap() {
     let mass = world.particles.mass[0];
     let theory = (3.0 * mass * g / (4.0 * e_star * RADIUS.sqrt())).powf(2.0 / 3.0);
     let err = (overlap - theory).abs() / theory;
+    eprintln!(
+        "static overlap {overlap:.6e} m, Hertz {theory:.6e} m ({:+.4} %)",
+        100.0 * (overlap / theory - 1.0)
+    );
     assert!(
         err < 0.01,
         "overlap {overlap:.6e} m vs Hertz {theory:.6e} m ({:.3} %)",

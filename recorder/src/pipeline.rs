@@ -78,10 +78,7 @@ impl Pipeline {
 }
 
 /// Splits `items` into consecutive mutable pieces, piece `b` covering `bounds[b]..bounds[b+1]`.
-fn split_by<'a, T>(
-    mut items: &'a mut [T],
-    bounds: impl Iterator<Item = (usize, usize)>,
-) -> Vec<&'a mut [T]> {
+fn split_by<T>(mut items: &mut [T], bounds: impl Iterator<Item = (usize, usize)>) -> Vec<&mut [T]> {
     let mut pieces = Vec::new();
     let mut at = 0;
     for (lo, hi) in bounds {

@@ -171,10 +171,10 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
             })?;
             positive("temperature.hot", hot)?;
             positive("temperature.cold", cold)?;
-            if temp.value.is_some() {
+            if let Some(v) = temp.value {
                 return Err(refuse(
                     "temperature.value",
-                    temp.value.unwrap(),
+                    v,
                     "only allowed when mode = \"uniform\"",
                 ));
             }

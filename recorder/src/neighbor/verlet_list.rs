@@ -52,7 +52,11 @@ impl NeighborList {
             .pos
             .par_iter()
             .zip(self.pos_at_build.par_iter())
-            .any(|(p, q)| !(norm2(sub(*p, *q)) <= limit))
+            .any(|(p, q)| {
+                // a NaN displacement also forces a rebuild (and the out-of-drum check then reports it)
+                let d2 = norm2(sub(*p, *q));
+                d2.is_nan() || d2 > limit
+            })
     }
 
     /// Re-sorts `particles` into cell order and rebuilds the list, carrying histories over.
