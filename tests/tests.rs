@@ -8,3 +8,4 @@ mod cli_run;
 mod drum;
 mod physics_collision;
 mod physics_conduction;
+mod record;

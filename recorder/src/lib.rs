@@ -15,6 +15,7 @@ pub mod math;
 pub mod neighbor;
 pub mod particles;
 pub mod pipeline;
+pub mod record;
 pub mod simulation;
 pub mod wall;
 

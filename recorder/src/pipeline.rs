@@ -125,17 +125,18 @@ pub fn pair_interactions(
     let offsets = &neighbors.offsets;
     let nbrs = &neighbors.neighbors;
     let block_bounds = (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
-    let history = split_by(
-        &mut neighbors.history,
+    let entry_bounds = || {
         block_bounds
             .clone()
-            .map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize)),
-    );
+            .map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize))
+    };
+    let history = split_by(&mut neighbors.history, entry_bounds());
+    let areas = split_by(&mut neighbors.sqrt_area, entry_bounds());
     let blocks: Vec<_> = force
         .chunks_mut(BLOCK)
         .zip(torque.chunks_mut(BLOCK))
         .zip(heat_flow.chunks_mut(BLOCK))
-        .zip(history)
+        .zip(history.into_iter().zip(areas))
         .enumerate()
         .collect();
     let state = |i: usize| SphereState {
@@ -147,39 +148,47 @@ pub fn pair_interactions(
     };
     let dt = params.dt;
     let (law, heat) = (&params.particle_particle, &params.conduction);
-    for_each_block(blocks, |(b, (((f_block, t_block), q_block), h_block))| {
-        let lo = b * BLOCK;
-        let base = offsets[lo] as usize;
-        let mut touching = 0;
-        for (k, ((f_out, t_out), q_out)) in f_block
-            .iter_mut()
-            .zip(t_block.iter_mut())
-            .zip(q_block.iter_mut())
-            .enumerate()
-        {
-            let i = lo + k;
-            let si = state(i);
-            let (mut f, mut t, mut q) = ([0.0; 3], [0.0; 3], 0.0);
-            for e in offsets[i] as usize..offsets[i + 1] as usize {
-                let j = nbrs[e] as usize;
-                let h: &mut ContactHistory = &mut h_block[e - base];
-                match sphere_sphere::kinematics(&si, &state(j)) {
-                    Some((kin, r)) => {
-                        let resp = hertz_mindlin::respond(law, &kin, h, dt);
-                        f = add(f, resp.force);
-                        t = add(t, resp.torque);
-                        q += heat.pair_conductance(r, si.radius, radius[j]) * (temp[j] - temp[i]);
-                        touching += 1;
+    for_each_block(
+        blocks,
+        |(b, (((f_block, t_block), q_block), (h_block, a_block)))| {
+            let lo = b * BLOCK;
+            let base = offsets[lo] as usize;
+            let mut touching = 0;
+            for (k, ((f_out, t_out), q_out)) in f_block
+                .iter_mut()
+                .zip(t_block.iter_mut())
+                .zip(q_block.iter_mut())
+                .enumerate()
+            {
+                let i = lo + k;
+                let si = state(i);
+                let (mut f, mut t, mut q) = ([0.0; 3], [0.0; 3], 0.0);
+                for e in offsets[i] as usize..offsets[i + 1] as usize {
+                    let j = nbrs[e] as usize;
+                    let h: &mut ContactHistory = &mut h_block[e - base];
+                    match sphere_sphere::kinematics(&si, &state(j)) {
+                        Some((kin, r)) => {
+                            let resp = hertz_mindlin::respond(law, &kin, h, dt);
+                            f = add(f, resp.force);
+                            t = add(t, resp.torque);
+                            let sqrt_area = heat.pair_area(r, si.radius, radius[j]).sqrt();
+                            q += heat.pair_conductivity * sqrt_area * (temp[j] - temp[i]);
+                            a_block[e - base] = sqrt_area;
+                            touching += 1;
+                        }
+                        None => {
+                            *h = ContactHistory::default();
+                            a_block[e - base] = 0.0;
+                        }
                     }
-                    None => *h = ContactHistory::default(),
                 }
+                *f_out = f;
+                *t_out = t;
+                *q_out = q;
             }
-            *f_out = f;
-            *t_out = t;
-            *q_out = q;
-        }
-        touching
-    })
+            touching
+        },
+    )
 }
 
 /// Sphere–wall forces and heated-wall conduction, added to the pair results.

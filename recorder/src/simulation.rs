@@ -265,6 +265,19 @@ impl Simulation {
         }
     }
 
+    /// Pairs touching at the last step, each once, in the order the DEM lists them:
+    /// `(id_a, id_b, sqrt(contact area))` — the recorder's sample.
+    pub fn touching_pairs(&self) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
+        let (list, ids) = (&self.neighbors, &self.particles.id);
+        (0..self.particles.len()).flat_map(move |i| {
+            list.range(i).filter_map(move |e| {
+                let j = list.neighbors[e] as usize;
+                let a = list.sqrt_area[e];
+                (a > 0.0 && ids[i] < ids[j]).then_some((ids[i], ids[j], a))
+            })
+        })
+    }
+
     /// Particle–particle contacts per particle in the last step (coordination number).
     pub fn contacts_per_particle(&self) -> f64 {
         self.last_contacts.pair_entries as f64 / self.particles.len() as f64

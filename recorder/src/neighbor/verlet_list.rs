@@ -19,6 +19,9 @@ pub struct NeighborList {
     pub neighbors: Vec<u32>,
     /// History of each entry's contact (zero while open).
     pub history: Vec<ContactHistory>,
+    /// `sqrt(contact area)` of each entry at the last step, 0 when not touching (the
+    /// recorder's per-sample input).
+    pub sqrt_area: Vec<f64>,
     /// Wall-contact histories, `walls` per particle, in slot order.
     pub wall_history: Vec<ContactHistory>,
     pub walls: usize,
@@ -171,6 +174,8 @@ impl NeighborList {
             self.neighbors.extend_from_slice(&nbrs);
             self.history.extend_from_slice(&hist);
         }
+        self.sqrt_area.clear();
+        self.sqrt_area.resize(self.neighbors.len(), 0.0);
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
         self.rebuilds += 1;

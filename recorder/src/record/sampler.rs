@@ -1,0 +1,298 @@
+//! The streaming contact sampler: fed the contact list every `n` steps, it closes rows as
+//! they complete (`Δt_c^max` reached, contact opened, or the period ends) and releases them
+//! in apparition order. Memory follows the open contacts, not the table.
+
+use super::CollisionRow;
+use std::collections::{BTreeMap, HashMap};
+
+/// A contact seen at the previous sample, with its row in progress.
+#[derive(Debug, Clone, Copy)]
+struct OpenContact {
+    row_start: u64,
+    samples: u32,
+    sqrt_area_sum: f64,
+    /// Apparition rank of the row in progress (meaningful while `samples > 0`).
+    seq: u64,
+    last_seen: u64,
+}
+
+/// Builds the collision table of one period from samples of the DEM contact list.
+#[derive(Debug, Clone)]
+pub struct ContactSampler {
+    /// Sampling factor `n` (steps per sample).
+    pub every: u32,
+    /// `Δt_c^max` in steps, a multiple of `n`.
+    pub max_duration: u32,
+    open: HashMap<(u32, u32), OpenContact>,
+    /// Completed rows not yet released, keyed by apparition rank.
+    done: BTreeMap<u64, CollisionRow>,
+    next_seq: u64,
+    /// Step of the last sample, if any.
+    last_sample: Option<u64>,
+}
+
+impl ContactSampler {
+    /// `None` unless `every > 0` and `max_duration` is a positive multiple of `every`.
+    pub fn new(every: u32, max_duration: u32) -> Option<Self> {
+        if every == 0 || max_duration == 0 || max_duration % every != 0 {
+            return None;
+        }
+        Some(Self {
+            every,
+            max_duration,
+            open: HashMap::new(),
+            done: BTreeMap::new(),
+            next_seq: 0,
+            last_sample: None,
+        })
+    }
+
+    /// Number of contacts currently open.
+    pub fn open_contacts(&self) -> usize {
+        self.open.len()
+    }
+
+    fn close_row(&mut self, key: (u32, u32), c: &mut OpenContact) {
+        if c.samples > 0 {
+            let row = CollisionRow {
+                i: key.0,
+                j: key.1,
+                start_step: c.row_start,
+                duration_steps: c.samples * self.every,
+                sqrt_area: c.sqrt_area_sum / c.samples as f64,
+            };
+            self.done.insert(c.seq, row);
+            c.samples = 0;
+            c.sqrt_area_sum = 0.0;
+        }
+    }
+
+    /// Records the contacts touching at `step`, in the order the DEM lists them; each pair
+    /// once, as `(id_a, id_b, sqrt(area))`. Steps must advance by `every`.
+    pub fn sample(&mut self, step: u64, contacts: impl IntoIterator<Item = (u32, u32, f64)>) {
+        debug_assert!(self
+            .last_sample
+            .is_none_or(|s| step == s + self.every as u64));
+        let full_row = self.max_duration / self.every;
+        for (a, b, sqrt_area) in contacts {
+            let key = (a.min(b), a.max(b));
+            let next_seq = &mut self.next_seq;
+            let c = self.open.entry(key).or_insert_with(|| OpenContact {
+                row_start: step,
+                samples: 0,
+                sqrt_area_sum: 0.0,
+                seq: 0,
+                last_seen: step,
+            });
+            if c.samples == 0 {
+                c.row_start = step;
+                c.seq = *next_seq;
+                *next_seq += 1;
+            }
+            c.samples += 1;
+            c.sqrt_area_sum += sqrt_area;
+            c.last_seen = step;
+            if c.samples == full_row {
+                let mut state = *c;
+                self.close_row(key, &mut state);
+                self.open.insert(key, state);
+            }
+        }
+        // contacts not seen at this sample have opened: their last row ends here
+        let gone: Vec<(u32, u32)> = self
+            .open
+            .iter()
+            .filter(|(_, c)| c.last_seen != step)
+            .map(|(k, _)| *k)
+            .collect();
+        for key in gone {
+            let mut c = self.open.remove(&key).expect("listed above");
+            self.close_row(key, &mut c);
+        }
+        self.last_sample = Some(step);
+    }
+
+    /// Rows that can no longer be preceded by another, in apparition order.
+    pub fn drain_ready(&mut self) -> Vec<CollisionRow> {
+        let oldest_open = self
+            .open
+            .values()
+            .filter(|c| c.samples > 0)
+            .map(|c| c.seq)
+            .min()
+            .unwrap_or(u64::MAX);
+        let later = self.done.split_off(&oldest_open);
+        let ready = std::mem::replace(&mut self.done, later);
+        ready.into_values().collect()
+    }
+
+    /// Ends the period: contacts still open are cut, and every remaining row is returned.
+    pub fn finish(&mut self) -> Vec<CollisionRow> {
+        let keys: Vec<(u32, u32)> = self.open.keys().copied().collect();
+        for key in keys {
+            let mut c = self.open.remove(&key).expect("listed above");
+            self.close_row(key, &mut c);
+        }
+        std::mem::take(&mut self.done).into_values().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Feeds `present(sample_index)` contacts for `samples` samples and returns all rows.
+    fn run(
+        every: u32,
+        max: u32,
+        samples: u64,
+        present: impl Fn(u64) -> Vec<(u32, u32, f64)>,
+    ) -> Vec<CollisionRow> {
+        let mut s = ContactSampler::new(every, max).unwrap();
+        let mut rows = Vec::new();
+        for k in 0..samples {
+            s.sample(k * every as u64, present(k));
+            rows.extend(s.drain_ready());
+        }
+        rows.extend(s.finish());
+        rows
+    }
+
+    #[test]
+    fn a_25_step_collision_splits_as_in_table_1() {
+        // n = 1: contact during samples 3..28 (25 steps)
+        let contact = |k: u64| {
+            if (3..28).contains(&k) {
+                vec![(4, 9, 1e-3)]
+            } else {
+                vec![]
+            }
+        };
+        let rows = run(1, 10, 40, contact);
+        let spans: Vec<(u64, u32)> = rows
+            .iter()
+            .map(|r| (r.start_step, r.duration_steps))
+            .collect();
+        assert_eq!(spans, vec![(3, 10), (13, 10), (23, 5)]);
+        let rows = run(1, 20, 40, contact);
+        let spans: Vec<(u64, u32)> = rows
+            .iter()
+            .map(|r| (r.start_step, r.duration_steps))
+            .collect();
+        assert_eq!(spans, vec![(3, 20), (23, 5)]);
+        assert!(rows
+            .iter()
+            .all(|r| (r.i, r.j) == (4, 9) && (r.sqrt_area / 1e-3 - 1.0).abs() < 1e-14));
+    }
+
+    #[test]
+    fn sampling_factor_scales_durations() {
+        // n = 5, Δt_c^max = 10 steps: 5 samples = 25 steps → 10 + 10 + 5
+        let rows = run(5, 10, 12, |k| {
+            if (2..7).contains(&k) {
+                vec![(1, 2, 1.0)]
+            } else {
+                vec![]
+            }
+        });
+        let spans: Vec<(u64, u32)> = rows
+            .iter()
+            .map(|r| (r.start_step, r.duration_steps))
+            .collect();
+        assert_eq!(spans, vec![(10, 10), (20, 10), (30, 5)]);
+    }
+
+    #[test]
+    fn contacts_open_at_t0_start_at_t0_and_open_at_t1_are_cut() {
+        let rows = run(1, 100, 10, |_| vec![(0, 1, 2.0)]);
+        assert_eq!(rows.len(), 1);
+        assert_eq!((rows[0].start_step, rows[0].duration_steps), (0, 10));
+    }
+
+    #[test]
+    fn rows_come_out_in_apparition_order_and_average_the_area() {
+        // pair A starts at 0 and lasts long; pair B starts at 1, ends at 3; C starts at 1 after B
+        let rows = run(1, 4, 8, |k| {
+            let mut c = vec![(0, 1, k as f64)];
+            if (1..3).contains(&k) {
+                c.push((5, 2, 1.0));
+            }
+            if k == 1 {
+                c.push((7, 8, 3.0));
+            }
+            c
+        });
+        let order: Vec<(u32, u32, u64)> = rows.iter().map(|r| (r.i, r.j, r.start_step)).collect();
+        assert_eq!(order, vec![(0, 1, 0), (2, 5, 1), (7, 8, 1), (0, 1, 4)]);
+        assert_eq!(rows[0].sqrt_area, (0.0 + 1.0 + 2.0 + 3.0) / 4.0);
+        let starts: Vec<u64> = rows.iter().map(|r| r.start_step).collect();
+        assert!(starts.windows(2).all(|w| w[0] <= w[1]));
+    }
+
+    #[test]
+    fn streaming_rows_equal_algorithm_2_on_random_contact_patterns() {
+        use crate::record::splitter::split;
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        let mut coin = move || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % 4 != 0
+        };
+        for (every, max) in [(1u32, 10u32), (2, 10), (5, 20), (10, 100)] {
+            let samples = 300u64;
+            // 6 pairs, each present at a sample with probability 3/4
+            let present: Vec<Vec<bool>> = (0..6)
+                .map(|_| (0..samples).map(|_| coin()).collect())
+                .collect();
+            let rows = run(every, max, samples, |k| {
+                (0..6u32)
+                    .filter(|&p| present[p as usize][k as usize])
+                    .map(|p| (p, p + 10, 1.0))
+                    .collect()
+            });
+            let mut expected = Vec::new();
+            for (p, seen) in present.iter().enumerate() {
+                let mut k = 0;
+                while k < samples as usize {
+                    if seen[k] {
+                        let first = k;
+                        while k < samples as usize && seen[k] {
+                            k += 1;
+                        }
+                        let (start, len) = (
+                            first as u64 * every as u64,
+                            (k - first) as u64 * every as u64,
+                        );
+                        expected.extend(
+                            split(start, len, max as u64)
+                                .into_iter()
+                                .map(|r| (r.0, p as u32, r.1 as u32)),
+                        );
+                    } else {
+                        k += 1;
+                    }
+                }
+            }
+            expected.sort();
+            let got: Vec<(u64, u32, u32)> = rows
+                .iter()
+                .map(|r| (r.start_step, r.i, r.duration_steps))
+                .collect();
+            assert!(
+                got.windows(2).all(|w| w[0].0 <= w[1].0),
+                "not in apparition order"
+            );
+            let mut sorted = got.clone();
+            sorted.sort();
+            assert_eq!(sorted, expected, "n = {every}, max = {max}");
+        }
+    }
+
+    #[test]
+    fn invalid_settings_are_refused() {
+        assert!(ContactSampler::new(0, 10).is_none());
+        assert!(ContactSampler::new(3, 10).is_none());
+        assert!(ContactSampler::new(5, 0).is_none());
+    }
+}
