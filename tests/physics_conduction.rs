@@ -57,3 +57,46 @@ fn pair_temperature_difference_decays_exponentially() {
     let start = ci * 30.0 + cj * 10.0;
     assert!(((total - start) / start).abs() < 1e-12);
 }
+
+#[test]
+fn sphere_on_a_heated_mantle_relaxes_towards_the_wall_temperature() {
+    use recorder::wall::{WallMotion, WallSet};
+    let radius = 0.005;
+    let mut p = ParticleSet::default();
+    p.push(0, [0.0, 0.0, -0.05 + radius], radius, DENSITY, 300.0);
+    let walls = WallSet::drum(0.05, 0.04, WallMotion::Fixed);
+    let dt = 1e-5;
+    let mut world = World::new(p, walls, 0.2, dt, 9.81);
+    with_threads(1, || {
+        for _ in 0..50_000 {
+            world.step(); // settle on the adiabatic mantle
+        }
+        assert_eq!(world.particles.temp[0], 300.0);
+        let (tw, t0) = (400.0, 300.0);
+        world.walls.mantle_temperature = Some(tw);
+        // independent of the engine: the disc where the sphere cuts the wall, H = 2K sqrt(A)
+        let [x, _, z] = world.particles.pos[0];
+        let overlap = (x * x + z * z).sqrt() + radius - 0.05;
+        let area = std::f64::consts::PI * (radius * radius - (radius - overlap).powi(2));
+        let h = 2.0 * CONDUCTIVITY * area.sqrt();
+        let c = world.particles.mass[0] * HEAT_CAPACITY;
+        let steps = 100_000;
+        for _ in 0..steps {
+            world.step();
+        }
+        let t = steps as f64 * dt;
+        let measured = (tw - world.particles.temp[0]) / (tw - t0);
+        let theory = (-h * t / c).exp();
+        eprintln!(
+            "heated mantle: (Tw − T)/(Tw − T0) = {measured:.9} vs exp(−H t / C) = {theory:.9}"
+        );
+        assert!(
+            (measured / theory - 1.0).abs() < 1e-6,
+            "{measured} vs {theory}"
+        );
+        assert!(
+            measured < 0.99,
+            "the wall must heat the sphere noticeably: {measured}"
+        );
+    });
+}
