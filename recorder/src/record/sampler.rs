@@ -16,6 +16,24 @@ struct OpenContact {
     last_seen: u64,
 }
 
+impl OpenContact {
+    /// Ends the row in progress (if it has samples) into `done`, keyed by its apparition rank.
+    fn close_row(&mut self, key: (u32, u32), every: u32, done: &mut BTreeMap<u64, CollisionRow>) {
+        if self.samples > 0 {
+            let row = CollisionRow {
+                i: key.0,
+                j: key.1,
+                start_step: self.row_start,
+                duration_steps: self.samples * every,
+                sqrt_area: self.sqrt_area_sum / self.samples as f64,
+            };
+            done.insert(self.seq, row);
+            self.samples = 0;
+            self.sqrt_area_sum = 0.0;
+        }
+    }
+}
+
 /// Builds the collision table of one period from samples of the DEM contact list.
 #[derive(Debug, Clone)]
 pub struct ContactSampler {
@@ -52,21 +70,6 @@ impl ContactSampler {
         self.open.len()
     }
 
-    fn close_row(&mut self, key: (u32, u32), c: &mut OpenContact) {
-        if c.samples > 0 {
-            let row = CollisionRow {
-                i: key.0,
-                j: key.1,
-                start_step: c.row_start,
-                duration_steps: c.samples * self.every,
-                sqrt_area: c.sqrt_area_sum / c.samples as f64,
-            };
-            self.done.insert(c.seq, row);
-            c.samples = 0;
-            c.sqrt_area_sum = 0.0;
-        }
-    }
-
     /// Records the contacts touching at `step`, in the order the DEM lists them; each pair
     /// once, as `(id_a, id_b, sqrt(area))`. Steps must advance by `every`.
     pub fn sample(&mut self, step: u64, contacts: impl IntoIterator<Item = (u32, u32, f64)>) {
@@ -93,22 +96,18 @@ impl ContactSampler {
             c.sqrt_area_sum += sqrt_area;
             c.last_seen = step;
             if c.samples == full_row {
-                let mut state = *c;
-                self.close_row(key, &mut state);
-                self.open.insert(key, state);
+                c.close_row(key, self.every, &mut self.done);
             }
         }
         // contacts not seen at this sample have opened: their last row ends here
-        let gone: Vec<(u32, u32)> = self
-            .open
-            .iter()
-            .filter(|(_, c)| c.last_seen != step)
-            .map(|(k, _)| *k)
-            .collect();
-        for key in gone {
-            let mut c = self.open.remove(&key).expect("listed above");
-            self.close_row(key, &mut c);
-        }
+        let (every, done) = (self.every, &mut self.done);
+        self.open.retain(|&key, c| {
+            let open = c.last_seen == step;
+            if !open {
+                c.close_row(key, every, done);
+            }
+            open
+        });
         self.last_sample = Some(step);
     }
 
@@ -128,10 +127,8 @@ impl ContactSampler {
 
     /// Ends the period: contacts still open are cut, and every remaining row is returned.
     pub fn finish(&mut self) -> Vec<CollisionRow> {
-        let keys: Vec<(u32, u32)> = self.open.keys().copied().collect();
-        for key in keys {
-            let mut c = self.open.remove(&key).expect("listed above");
-            self.close_row(key, &mut c);
+        for (key, mut c) in self.open.drain() {
+            c.close_row(key, self.every, &mut self.done);
         }
         std::mem::take(&mut self.done).into_values().collect()
     }
