@@ -2,6 +2,8 @@
 //! errors to an exit code (2: bad input, 1: the run failed).
 
 mod cli;
+mod inspect;
+mod record;
 mod run;
 
 use std::process::ExitCode;
@@ -10,15 +12,20 @@ fn main() -> ExitCode {
     let args = cli::Cli::parse_args();
     let result = cli::Plan::from_args(args).and_then(|plan| match plan {
         cli::Plan::Run(p) => run::run(&p),
+        cli::Plan::Record(p) => record::run(&p),
+        cli::Plan::Inspect(p) => inspect::run(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
-            if err
-                .chain()
-                .any(|e| e.is::<recorder::CaseError>() || e.is::<cli::UsageError>())
-            {
+            let bad_input = |e: &(dyn std::error::Error + 'static)| {
+                e.is::<recorder::CaseError>()
+                    || e.is::<cli::UsageError>()
+                    || e.downcast_ref::<recorder::format::FormatError>()
+                        .is_some_and(|f| f.is_bad_input())
+            };
+            if err.chain().any(bad_input) {
                 ExitCode::from(2)
             } else {
                 ExitCode::from(1)

@@ -4,6 +4,7 @@
 mod util;
 
 mod cli_case_errors;
+mod cli_record;
 mod cli_run;
 mod drum;
 mod physics_collision;

@@ -8,6 +8,7 @@
 pub mod case;
 pub mod contact;
 pub mod counters;
+pub mod format;
 pub mod heat;
 pub mod insertion;
 pub mod integrate;

@@ -4,6 +4,7 @@
 use crate::case::{Case, EndCaps, TemperatureMode};
 use crate::contact::PairLaw;
 use crate::counters::Counters;
+use crate::format::Snapshot;
 use crate::heat::ConductionLaw;
 use crate::insertion;
 use crate::neighbor::{CellGrid, NeighborList};
@@ -276,6 +277,48 @@ impl Simulation {
                 (a > 0.0 && ids[i] < ids[j]).then_some((ids[i], ids[j], a))
             })
         })
+    }
+
+    /// Particles touching a conducting wall now, each as `(id, particles + wall, sqrt(A))`:
+    /// the wall rows of the recorder's sample (none when the walls are adiabatic).
+    pub fn touching_walls(&self) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
+        let p = &self.particles;
+        let n = p.len() as u32;
+        let conducting = (0..self.walls.len()).filter(|&w| self.walls.temperature(w).is_some());
+        // a bit per conducting wall (a drum has three walls)
+        let mask: u64 = conducting.map(|w| 1u64 << w).sum();
+        let particles = if mask == 0 { 0 } else { p.len() };
+        (0..particles).flat_map(move |i| {
+            (0..self.walls.len())
+                .filter(move |&w| mask & (1 << w) != 0)
+                .filter_map(move |w| {
+                    self.walls.contact(w, p.pos[i], p.radius[i]).map(|c| {
+                        let sqrt_area = self
+                            .params
+                            .conduction
+                            .wall_sqrt_area(c.overlap, p.radius[i]);
+                        (p.id[i], n + w as u32, sqrt_area)
+                    })
+                })
+        })
+    }
+
+    /// The particles now, in id order, as snapshot `index` of a recording.
+    pub fn snapshot(&self, index: u32) -> Snapshot {
+        let p = &self.particles;
+        let mut slot = vec![0usize; p.len()];
+        for (i, &id) in p.id.iter().enumerate() {
+            slot[id as usize] = i;
+        }
+        Snapshot {
+            index,
+            time: self.time,
+            id: (0..p.len() as u32).collect(),
+            pos: slot.iter().map(|&i| p.pos[i]).collect(),
+            radius: slot.iter().map(|&i| p.radius[i]).collect(),
+            temp: slot.iter().map(|&i| p.temp[i]).collect(),
+            vel: slot.iter().map(|&i| p.vel[i]).collect(),
+        }
     }
 
     /// Particle–particle contacts per particle in the last step (coordination number).

@@ -27,6 +27,48 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Record one period: run the case to t0, assign temperatures, record the sampled
+    /// collision table and the snapshots at t0 and t1 (and K reference periods) into MCAP.
+    Record {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Period τ in seconds (default: one drum revolution).
+        #[arg(long, conflicts_with = "tau_rev")]
+        tau: Option<f64>,
+        /// Period τ as a fraction of a drum revolution.
+        #[arg(long = "tau-rev")]
+        tau_rev: Option<f64>,
+        /// Sampling factor n: the contact list is sampled every n DEM steps.
+        #[arg(long = "n", default_value_t = 10)]
+        n: u32,
+        /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
+        #[arg(long = "dtc-max", default_value_t = 100)]
+        dtc_max: u32,
+        /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
+        #[arg(long, default_value_t = 0)]
+        reference: u32,
+        /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
+        #[arg(long = "exact-area")]
+        exact_area: bool,
+        /// Worker threads (default: all cores). The recording does not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
+    /// suggested n, costs. Reads the whole table, so it also checks the file.
+    Inspect {
+        /// The recording (MCAP).
+        file: PathBuf,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 impl Cli {

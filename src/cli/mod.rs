@@ -4,4 +4,4 @@ mod args;
 mod plan;
 
 pub use args::Cli;
-pub use plan::{Plan, RunPlan, UsageError};
+pub use plan::{InspectPlan, Plan, RecordPlan, RunPlan, UsageError};

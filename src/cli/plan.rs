@@ -2,6 +2,8 @@
 
 use super::args::{Cli, Command};
 use anyhow::Result;
+use recorder::format::AreaEncoding;
+use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
 
@@ -19,6 +21,23 @@ impl std::error::Error for UsageError {}
 
 pub enum Plan {
     Run(RunPlan),
+    Record(RecordPlan),
+    Inspect(InspectPlan),
+}
+
+pub struct RecordPlan {
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub output: PathBuf,
+    pub options: RecordOptions,
+    pub threads: usize,
+    pub json: bool,
+}
+
+pub struct InspectPlan {
+    pub file: PathBuf,
+    pub json: bool,
 }
 
 pub struct RunPlan {
@@ -53,6 +72,123 @@ impl Plan {
                     json,
                 }))
             }
+            Command::Record {
+                case,
+                output,
+                tau,
+                tau_rev,
+                n,
+                dtc_max,
+                reference,
+                exact_area,
+                threads: t,
+                json,
+            } => {
+                let threads = threads(t)?;
+                let loaded = recorder::case::load(&case)?;
+                let case_toml = std::fs::read_to_string(&case)?;
+                let options =
+                    record_options(&loaded, tau, tau_rev, n, dtc_max, reference, exact_area)?;
+                check_output(&output)?;
+                Ok(Plan::Record(RecordPlan {
+                    case_path: case,
+                    case_toml,
+                    case: loaded,
+                    output,
+                    options,
+                    threads,
+                    json,
+                }))
+            }
+            Command::Inspect { file, json } => Ok(Plan::Inspect(InspectPlan { file, json })),
         }
     }
+}
+
+fn usage(message: String) -> anyhow::Error {
+    UsageError(message).into()
+}
+
+/// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.
+fn record_options(
+    case: &Case,
+    tau: Option<f64>,
+    tau_rev: Option<f64>,
+    n: u32,
+    dtc_max: u32,
+    reference: u32,
+    exact_area: bool,
+) -> Result<RecordOptions> {
+    let revolution = case.drum.rotation_period;
+    let tau_seconds = match (tau, tau_rev) {
+        (Some(t), _) if !(t.is_finite() && t > 0.0) => {
+            return Err(usage(format!(
+                "--tau = {t} is not allowed: give a period > 0 s"
+            )))
+        }
+        (_, Some(f)) if !(f.is_finite() && f > 0.0) => {
+            return Err(usage(format!(
+                "--tau-rev = {f} is not allowed: give a fraction of a revolution > 0"
+            )))
+        }
+        (Some(t), _) => t,
+        (_, Some(f)) => f * revolution,
+        (None, None) => revolution,
+    };
+    if n == 0 {
+        return Err(usage(
+            "--n = 0 is not allowed: the sampling factor is at least 1 step".into(),
+        ));
+    }
+    if dtc_max == 0 || dtc_max % n != 0 {
+        return Err(usage(format!(
+            "--dtc-max = {dtc_max} is not allowed: Δt_c^max must be a positive multiple of n = {n} steps (e.g. {})",
+            n * (dtc_max / n).max(1)
+        )));
+    }
+    let exact_steps = tau_seconds / case.time.dt;
+    let period_steps = exact_steps.round() as u64;
+    if period_steps == 0
+        || (exact_steps - period_steps as f64).abs() > 1e-6 * exact_steps
+        || period_steps % n as u64 != 0
+    {
+        let valid = (exact_steps / n as f64).round().max(1.0) * n as f64 * case.time.dt;
+        return Err(usage(format!(
+            "τ = {tau_seconds} s is {exact_steps} DEM steps of {} s: it must be a whole multiple of n = {n} steps (nearest allowed τ = {valid} s)",
+            case.time.dt
+        )));
+    }
+    Ok(RecordOptions {
+        sample_every: n,
+        dtc_max_steps: dtc_max,
+        period_steps,
+        reference_periods: reference,
+        area_encoding: if exact_area {
+            AreaEncoding::Exact
+        } else {
+            AreaEncoding::Quantized
+        },
+    })
+}
+
+/// The output must be a file path in an existing directory.
+fn check_output(output: &std::path::Path) -> Result<()> {
+    if output.is_dir() {
+        return Err(usage(format!(
+            "-o {}: is a directory; give a file name such as run.mcap",
+            output.display()
+        )));
+    }
+    let parent = output
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(usage(format!(
+            "-o {}: the directory {} does not exist",
+            output.display(),
+            parent.display()
+        )));
+    }
+    Ok(())
 }

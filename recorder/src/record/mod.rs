@@ -1,9 +1,11 @@
 //! The sampled collision table (Haydar §2.1.1): a sampler fed every `n` DEM steps and the
 //! splitter that cuts collisions longer than `Δt_c^max` into rows (Algorithm 2).
 
+pub mod recording;
 pub mod sampler;
 pub mod splitter;
 
+pub use recording::{record, Phase, RecordError, RecordOptions};
 pub use sampler::ContactSampler;
 
 /// One row of the collision table, times in DEM steps from the recording's origin.

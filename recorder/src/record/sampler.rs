@@ -3,7 +3,8 @@
 //! in apparition order. Memory follows the open contacts, not the table.
 
 use super::CollisionRow;
-use std::collections::{BTreeMap, HashMap};
+use rustc_hash::FxHashMap;
+use std::collections::BTreeMap;
 
 /// A contact seen at the previous sample, with its row in progress.
 #[derive(Debug, Clone, Copy)]
@@ -14,6 +15,8 @@ struct OpenContact {
     /// Apparition rank of the row in progress (meaningful while `samples > 0`).
     seq: u64,
     last_seen: u64,
+    /// Samples of the whole collision so far (across its rows).
+    collision_samples: u32,
 }
 
 impl OpenContact {
@@ -41,12 +44,15 @@ pub struct ContactSampler {
     pub every: u32,
     /// `Δt_c^max` in steps, a multiple of `n`.
     pub max_duration: u32,
-    open: HashMap<(u32, u32), OpenContact>,
+    /// Open contacts by pair; Fx hashing because the map is probed once per contact per sample.
+    open: FxHashMap<(u32, u32), OpenContact>,
     /// Completed rows not yet released, keyed by apparition rank.
     done: BTreeMap<u64, CollisionRow>,
     next_seq: u64,
     /// Step of the last sample, if any.
     last_sample: Option<u64>,
+    /// `histogram[s]`: ended collisions seen at `s` consecutive samples.
+    histogram: Vec<u64>,
 }
 
 impl ContactSampler {
@@ -58,10 +64,11 @@ impl ContactSampler {
         Some(Self {
             every,
             max_duration,
-            open: HashMap::new(),
+            open: FxHashMap::default(),
             done: BTreeMap::new(),
             next_seq: 0,
             last_sample: None,
+            histogram: Vec::new(),
         })
     }
 
@@ -86,6 +93,7 @@ impl ContactSampler {
                 sqrt_area_sum: 0.0,
                 seq: 0,
                 last_seen: step,
+                collision_samples: 0,
             });
             if c.samples == 0 {
                 c.row_start = step;
@@ -93,6 +101,7 @@ impl ContactSampler {
                 *next_seq += 1;
             }
             c.samples += 1;
+            c.collision_samples += 1;
             c.sqrt_area_sum += sqrt_area;
             c.last_seen = step;
             if c.samples == full_row {
@@ -100,15 +109,22 @@ impl ContactSampler {
             }
         }
         // contacts not seen at this sample have opened: their last row ends here
-        let (every, done) = (self.every, &mut self.done);
+        let (every, done, histogram) = (self.every, &mut self.done, &mut self.histogram);
         self.open.retain(|&key, c| {
             let open = c.last_seen == step;
             if !open {
                 c.close_row(key, every, done);
+                count(histogram, c.collision_samples);
             }
             open
         });
         self.last_sample = Some(step);
+    }
+
+    /// Ended collisions by length in samples (`[s]`: seen at `s` consecutive samples); after
+    /// [`Self::finish`] it includes the collisions cut at the end of the period.
+    pub fn duration_histogram(&self) -> &[u64] {
+        &self.histogram
     }
 
     /// Rows that can no longer be preceded by another, in apparition order.
@@ -129,9 +145,18 @@ impl ContactSampler {
     pub fn finish(&mut self) -> Vec<CollisionRow> {
         for (key, mut c) in self.open.drain() {
             c.close_row(key, self.every, &mut self.done);
+            count(&mut self.histogram, c.collision_samples);
         }
         std::mem::take(&mut self.done).into_values().collect()
     }
+}
+
+fn count(histogram: &mut Vec<u64>, samples: u32) {
+    let s = samples as usize;
+    if histogram.len() <= s {
+        histogram.resize(s + 1, 0);
+    }
+    histogram[s] += 1;
 }
 
 #[cfg(test)]
@@ -284,6 +309,27 @@ mod tests {
             sorted.sort();
             assert_eq!(sorted, expected, "n = {every}, max = {max}");
         }
+    }
+
+    #[test]
+    fn the_histogram_counts_whole_collisions_before_splitting() {
+        let mut s = ContactSampler::new(1, 10).unwrap();
+        // pair (1,2): 25 samples (3 rows); pair (3,4): 2 samples, twice
+        for k in 0..30u64 {
+            let mut c = Vec::new();
+            if k < 25 {
+                c.push((1, 2, 1.0));
+            }
+            if k < 2 || (5..7).contains(&k) {
+                c.push((3, 4, 1.0));
+            }
+            s.sample(k, c);
+        }
+        let rows = s.finish();
+        assert_eq!(rows.len(), 3 + 2);
+        let h = s.duration_histogram();
+        assert_eq!(h.len(), 26);
+        assert_eq!((h[2], h[25], h.iter().sum::<u64>()), (2, 1, 3));
     }
 
     #[test]

@@ -1,0 +1,168 @@
+//! The recording file (MCAP, DESIGN.md §4; layout in docs/file-format.md): what a recording
+//! holds, the writer used by `tdex record` and the streaming reader used by `extrapolate`.
+
+pub mod proto;
+pub mod reader;
+pub mod snapshot;
+pub mod table;
+pub mod writer;
+
+pub use reader::RecordingReader;
+pub use snapshot::Snapshot;
+pub use table::TableBatch;
+pub use writer::RecordingWriter;
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// MCAP header profile of a tdex recording.
+pub const PROFILE: &str = "tdex";
+/// Version of the layout below; readers refuse other versions.
+pub const FORMAT_VERSION: u32 = 1;
+/// Channel of the particle snapshots (`foxglove.PointCloud`).
+pub const SNAPSHOT_TOPIC: &str = "/tdex/snapshots";
+/// Channel of the collision table (`tdex.CollisionBatch`).
+pub const COLLISION_TOPIC: &str = "/tdex/collisions";
+/// Metadata record written first: [`RecordingInfo`] as JSON under the key `json`.
+pub const INFO_METADATA: &str = "tdex.recording";
+/// Metadata record written after the table: [`RecordingSummary`] as JSON under the key `json`.
+pub const SUMMARY_METADATA: &str = "tdex.summary";
+/// Metadata record written last: [`RecordingCosts`] as JSON under the key `json`. The only
+/// part of a recording that depends on the machine and thread count: the file is identical
+/// byte for byte up to this record.
+pub const COSTS_METADATA: &str = "tdex.costs";
+/// Quantisation of `sqrt(a)`: the code range `0..=65535` spans `sqrt(π)·R_max`, the largest
+/// value a lens or wall disc can take, so a code fits 16 bits (stored as a varint).
+pub const SQRT_AREA_CODES: f64 = 65535.0;
+
+/// How the per-row `sqrt(a)` is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AreaEncoding {
+    /// Integer codes of `sqrt(π)·R_max / 65535` m (relative error ~1e-4 on a typical contact).
+    Quantized,
+    /// `f64` metres, bit-exact (for self-consistency checks; ~2 bytes more per row).
+    Exact,
+}
+
+/// A wall that can appear in the table as body `particles + index`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct WallInfo {
+    /// Body id in the table: `particles + wall index`.
+    pub id: u32,
+    /// `mantle`, `cap_low` or `cap_high`.
+    pub kind: String,
+    /// Fixed temperature (K) when the wall conducts; `None` for an adiabatic wall.
+    pub temperature: Option<f64>,
+}
+
+/// Everything about how a recording was made; the first metadata record of the file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecordingInfo {
+    pub format_version: u32,
+    pub tool_version: String,
+    /// The case file as given (TOML text) and its path when recorded.
+    pub case_toml: String,
+    pub case_path: String,
+    /// The case as resolved (all defaults filled in).
+    pub case_resolved: serde_json::Value,
+    pub particles: u32,
+    pub walls: Vec<WallInfo>,
+    /// DEM time step (s).
+    pub dt: f64,
+    /// Sampling factor `n` (steps per sample).
+    pub sample_every: u32,
+    /// `Δt_c^max` in steps.
+    pub dtc_max_steps: u32,
+    /// `τ` in steps and seconds.
+    pub period_steps: u64,
+    pub tau: f64,
+    /// `t0`: simulated time and step count at the start of the recorded period.
+    pub t0: f64,
+    pub step_t0: u64,
+    /// Reference periods stored after `t1` (`--reference K`).
+    pub reference_periods: u32,
+    pub area_encoding: AreaEncoding,
+    /// Metres per `sqrt(a)` code (quantised encoding), else 0.
+    pub sqrt_area_unit: f64,
+    /// `H = pair_conductivity · sqrt(a)` for a particle row (W/K per m).
+    pub pair_conductivity: f64,
+    /// `H = wall_conductivity · sqrt(a)` for a wall row.
+    pub wall_conductivity: f64,
+    /// Particle material: `C = density · heat_capacity · (4/3)π r³`.
+    pub density: f64,
+    pub heat_capacity: f64,
+    pub conductivity: f64,
+}
+
+impl RecordingInfo {
+    /// Simulated time of the snapshot with this index (0: `t0`, 1: `t1`, k: `t0 + kτ`).
+    pub fn snapshot_time(&self, index: u32) -> f64 {
+        (self.step_t0 + index as u64 * self.period_steps) as f64 * self.dt
+    }
+}
+
+/// What the recorded period holds; written after the table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecordingSummary {
+    /// Rows of the table, of which wall rows.
+    pub rows: u64,
+    pub wall_rows: u64,
+    pub batches: u64,
+    /// Collisions (before splitting) by sampled length: entry `s` counts the collisions seen
+    /// at `s` consecutive samples, i.e. lasting between `(s−1)n+1` and `(s+1)n−1` steps.
+    /// Collisions open at `t0` or `t1` count with their length inside the period.
+    pub duration_histogram: Vec<u64>,
+    /// Snapshots stored (`t0`, `t1`, then one per reference period).
+    pub snapshots: u32,
+}
+
+/// What the run cost, for the speedup report; the last metadata record.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecordingCosts {
+    /// Wall-clock seconds: DEM to `t0`, the recorded period (DEM + recorder), the reference.
+    pub seconds_to_t0: f64,
+    pub seconds_period: f64,
+    pub seconds_reference: f64,
+    /// Of `seconds_period`, the time spent sampling, splitting, encoding and writing.
+    pub seconds_recorder: f64,
+    /// Per-stage DEM seconds over the whole run.
+    pub stage_seconds: BTreeMap<String, f64>,
+    pub threads: usize,
+}
+
+/// Why a recording cannot be written or read.
+#[derive(Debug, thiserror::Error)]
+pub enum FormatError {
+    #[error("{path}: cannot open: {error}")]
+    Open {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{path}: cannot write: {error}")]
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{path}: not an MCAP file (it does not start with the MCAP magic bytes)")]
+    NotMcap { path: PathBuf },
+    #[error("{path}: the MCAP file is truncated or was not finished (no summary section / footer); record it again")]
+    Truncated { path: PathBuf },
+    #[error("{path}: an MCAP file, but not a tdex recording: {detail}")]
+    NotRecording { path: PathBuf, detail: String },
+    #[error("{path}: corrupted recording: {detail}")]
+    Corrupt { path: PathBuf, detail: String },
+    #[error("{path}: MCAP error: {error}")]
+    Mcap {
+        path: PathBuf,
+        error: mcap::McapError,
+    },
+}
+
+impl FormatError {
+    /// Whether the error is in a file the user gave (exit code 2), not in writing one.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, FormatError::Write { .. } | FormatError::Mcap { .. })
+    }
+}

@@ -1,0 +1,240 @@
+//! Writes a recording: to a temporary file beside the destination, renamed only by
+//! [`RecordingWriter::finish`], so an interrupted run never leaves a file that looks complete.
+
+use super::proto::{COLLISION_BATCH_DESCRIPTOR, POINT_CLOUD_DESCRIPTOR};
+use super::table::{self, BATCH_ROWS};
+use super::*;
+use crate::record::CollisionRow;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Uncompressed chunk size: several batches per chunk, so that zstd finds the rows of a long
+/// contact again in the next batch.
+const CHUNK_BYTES: u64 = 8 << 20;
+
+pub struct RecordingWriter {
+    mcap: Option<mcap::Writer<BufWriter<File>>>,
+    info: RecordingInfo,
+    dest: PathBuf,
+    partial: PathBuf,
+    snapshot_channel: u16,
+    collision_channel: u16,
+    pending: Vec<CollisionRow>,
+    rows_written: u64,
+    batches: u64,
+    wall_rows: u64,
+    snapshots: u32,
+}
+
+impl RecordingWriter {
+    /// Starts a recording at `dest` (written to a hidden partial file until `finish`).
+    pub fn create(dest: &Path, info: RecordingInfo) -> Result<Self, FormatError> {
+        let name = dest
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "recording.mcap".into());
+        let partial = dest.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+        let write_err = |error| FormatError::Write {
+            path: dest.to_path_buf(),
+            error,
+        };
+        let file = File::create(&partial).map_err(write_err)?;
+        let mcap_err = |error| FormatError::Mcap {
+            path: dest.to_path_buf(),
+            error,
+        };
+        let mut mcap = mcap::WriteOptions::new()
+            .profile(PROFILE)
+            .library(format!("tdex {}", env!("CARGO_PKG_VERSION")))
+            .compression(Some(mcap::Compression::Zstd))
+            .chunk_size(Some(CHUNK_BYTES))
+            .create(BufWriter::with_capacity(1 << 20, file))
+            .map_err(mcap_err)?;
+        let json = serde_json::to_string(&info).expect("the info serialises");
+        mcap.write_metadata(&mcap::records::Metadata {
+            name: INFO_METADATA.into(),
+            metadata: BTreeMap::from([("json".to_string(), json)]),
+        })
+        .map_err(mcap_err)?;
+        let snapshot_schema = mcap
+            .add_schema("foxglove.PointCloud", "protobuf", POINT_CLOUD_DESCRIPTOR)
+            .map_err(mcap_err)?;
+        let collision_schema = mcap
+            .add_schema(
+                "tdex.CollisionBatch",
+                "protobuf",
+                COLLISION_BATCH_DESCRIPTOR,
+            )
+            .map_err(mcap_err)?;
+        let snapshot_channel = mcap
+            .add_channel(
+                snapshot_schema,
+                SNAPSHOT_TOPIC,
+                "protobuf",
+                &BTreeMap::new(),
+            )
+            .map_err(mcap_err)?;
+        let collision_channel = mcap
+            .add_channel(
+                collision_schema,
+                COLLISION_TOPIC,
+                "protobuf",
+                &BTreeMap::new(),
+            )
+            .map_err(mcap_err)?;
+        Ok(Self {
+            mcap: Some(mcap),
+            info,
+            dest: dest.to_path_buf(),
+            partial,
+            snapshot_channel,
+            collision_channel,
+            pending: Vec::with_capacity(BATCH_ROWS),
+            rows_written: 0,
+            batches: 0,
+            wall_rows: 0,
+            snapshots: 0,
+        })
+    }
+
+    fn mcap_err(&self, error: mcap::McapError) -> FormatError {
+        FormatError::Mcap {
+            path: self.dest.clone(),
+            error,
+        }
+    }
+
+    fn nanos(&self, step: u64) -> u64 {
+        (step as f64 * self.info.dt * 1e9).round() as u64
+    }
+
+    /// Stores a snapshot in its own chunk (the table chunks then hold only table rows).
+    pub fn write_snapshot(&mut self, snapshot: &Snapshot) -> Result<(), FormatError> {
+        let step = self.info.step_t0 + snapshot.index as u64 * self.info.period_steps;
+        let time = self.nanos(step);
+        let data = snapshot.encode();
+        let header = mcap::records::MessageHeader {
+            channel_id: self.snapshot_channel,
+            sequence: snapshot.index,
+            log_time: time,
+            publish_time: time,
+        };
+        let mcap = self.mcap.as_mut().expect("not finished");
+        let result = mcap
+            .flush()
+            .and_then(|_| mcap.write_to_known_channel(&header, &data))
+            .and_then(|_| mcap.flush());
+        self.snapshots += 1;
+        result.map_err(|e| self.mcap_err(e))
+    }
+
+    /// Appends rows (in apparition order); full batches are encoded and written at once.
+    pub fn push_rows(
+        &mut self,
+        rows: impl IntoIterator<Item = CollisionRow>,
+    ) -> Result<(), FormatError> {
+        for row in rows {
+            self.wall_rows += (row.j >= self.info.particles) as u64;
+            self.pending.push(row);
+            if self.pending.len() == BATCH_ROWS {
+                self.write_batch()?;
+            }
+        }
+        Ok(())
+    }
+
+    fn write_batch(&mut self) -> Result<(), FormatError> {
+        if self.pending.is_empty() {
+            return Ok(());
+        }
+        let data = table::encode(
+            self.rows_written,
+            &self.pending,
+            self.info.area_encoding,
+            self.info.sqrt_area_unit,
+        );
+        let time = self.nanos(self.info.step_t0 + self.pending[0].start_step);
+        let header = mcap::records::MessageHeader {
+            channel_id: self.collision_channel,
+            sequence: self.batches as u32,
+            log_time: time,
+            publish_time: time,
+        };
+        let result = self
+            .mcap
+            .as_mut()
+            .expect("not finished")
+            .write_to_known_channel(&header, &data);
+        result.map_err(|e| self.mcap_err(e))?;
+        self.rows_written += self.pending.len() as u64;
+        self.batches += 1;
+        self.pending.clear();
+        Ok(())
+    }
+
+    /// Rows and batches written so far (pending rows included in `rows`).
+    pub fn rows(&self) -> u64 {
+        self.rows_written + self.pending.len() as u64
+    }
+
+    /// Writes the last batch, the summary (with the collision-duration histogram) and the
+    /// costs, ends the MCAP file and renames it into place.
+    pub fn finish(
+        mut self,
+        duration_histogram: Vec<u64>,
+        costs: &RecordingCosts,
+    ) -> Result<RecordingSummary, FormatError> {
+        self.write_batch()?;
+        let summary = RecordingSummary {
+            rows: self.rows_written,
+            wall_rows: self.wall_rows,
+            batches: self.batches,
+            duration_histogram,
+            snapshots: self.snapshots,
+        };
+        let mut mcap = self.mcap.take().expect("finished once");
+        let dest = self.dest.clone();
+        let mcap_err = |error| FormatError::Mcap {
+            path: dest.clone(),
+            error,
+        };
+        for (name, json) in [
+            (SUMMARY_METADATA, serde_json::to_string(&summary)),
+            (COSTS_METADATA, serde_json::to_string(costs)),
+        ] {
+            let metadata = mcap::records::Metadata {
+                name: name.into(),
+                metadata: BTreeMap::from([("json".to_string(), json.expect("serialisable"))]),
+            };
+            mcap.write_metadata(&metadata).map_err(mcap_err)?;
+        }
+        mcap.finish().map_err(mcap_err)?;
+        let file = mcap
+            .into_inner()
+            .into_inner()
+            .map_err(|e| FormatError::Write {
+                path: dest.clone(),
+                error: e.into_error(),
+            })?;
+        let write_err = |error| FormatError::Write {
+            path: dest.clone(),
+            error,
+        };
+        file.sync_all().map_err(write_err)?;
+        std::fs::rename(&self.partial, &self.dest).map_err(write_err)?;
+        Ok(summary)
+    }
+}
+
+impl Drop for RecordingWriter {
+    /// An unfinished recording is removed, never left looking complete.
+    fn drop(&mut self) {
+        if let Some(mcap) = self.mcap.take() {
+            // the mcap writer finishes itself on drop; the partial file goes anyway
+            drop(mcap);
+            let _ = std::fs::remove_file(&self.partial);
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! `tdex record` as a library call: run the case to `t0`, assign the temperatures, record one
+//! period `τ` (sampled table + snapshots at `t0` and `t1`) and, optionally, K reference periods.
+
+use super::ContactSampler;
+use crate::case::Case;
+use crate::format::{
+    AreaEncoding, FormatError, RecordingCosts, RecordingInfo, RecordingSummary, RecordingWriter,
+    WallInfo, FORMAT_VERSION, SQRT_AREA_CODES,
+};
+use crate::{Simulation, SimulationError};
+use std::path::Path;
+use std::time::Instant;
+
+/// What to record, validated by the caller (the CLI plan).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RecordOptions {
+    /// Sampling factor `n` (steps).
+    pub sample_every: u32,
+    /// `Δt_c^max` in steps, a positive multiple of `n`.
+    pub dtc_max_steps: u32,
+    /// `τ` in steps, a positive multiple of `n`.
+    pub period_steps: u64,
+    /// Reference periods after `t1`.
+    pub reference_periods: u32,
+    pub area_encoding: AreaEncoding,
+}
+
+/// The stage a progress report belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    Settle,
+    SpinUp,
+    Period,
+    Reference,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    #[error(transparent)]
+    Simulation(#[from] SimulationError),
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    #[error("invalid recording settings: {0}")]
+    Settings(String),
+}
+
+/// Steps between progress reports and stability checks outside the recorded period.
+const REPORT_EVERY: u64 = 500;
+
+/// Runs the case and writes the recording to `dest`. `case_toml` is the case file as given.
+pub fn record(
+    case: &Case,
+    case_path: &Path,
+    case_toml: &str,
+    opts: &RecordOptions,
+    dest: &Path,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let mut sampler =
+        ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
+            RecordError::Settings(format!(
+                "Δt_c^max = {} steps must be a positive multiple of n = {}",
+                opts.dtc_max_steps, opts.sample_every
+            ))
+        })?;
+    let every = opts.sample_every as u64;
+    if opts.period_steps == 0 || opts.period_steps % every != 0 {
+        return Err(RecordError::Settings(format!(
+            "τ = {} steps must be a positive multiple of n = {every}",
+            opts.period_steps
+        )));
+    }
+    let started = Instant::now();
+    let mut sim = Simulation::new(case)?;
+    let (n_settle, n_spin) = (
+        case.steps_in(case.time.settle),
+        case.steps_in(case.time.spin_up),
+    );
+    sim.run(n_settle, REPORT_EVERY, &mut |s| {
+        progress(Phase::Settle, s, n_settle)
+    })?;
+    sim.start_rotation();
+    sim.run(n_spin, REPORT_EVERY, &mut |s| {
+        progress(Phase::SpinUp, s, n_spin)
+    })?;
+    sim.assign_temperatures();
+    let seconds_to_t0 = started.elapsed().as_secs_f64();
+
+    let info = recording_info(&sim, case_path, case_toml, opts);
+    let mut writer = RecordingWriter::create(dest, info)?;
+    writer.write_snapshot(&sim.snapshot(0))?;
+
+    let period_start = Instant::now();
+    let mut recorder_seconds = 0.0;
+    let mut k = 0;
+    while k < opts.period_steps {
+        let t = Instant::now();
+        // the contact list at t0 + k dt, as computed by the step that ended there
+        sampler.sample(k, sim.touching_pairs().chain(sim.touching_walls()));
+        writer.push_rows(sampler.drain_ready())?;
+        recorder_seconds += t.elapsed().as_secs_f64();
+        sim.run(every, every, &mut |_| {})?;
+        k += every;
+        if k % REPORT_EVERY < every || k == opts.period_steps {
+            progress(Phase::Period, k, opts.period_steps);
+        }
+    }
+    let t = Instant::now();
+    writer.push_rows(sampler.finish())?;
+    writer.write_snapshot(&sim.snapshot(1))?;
+    recorder_seconds += t.elapsed().as_secs_f64();
+    let seconds_period = period_start.elapsed().as_secs_f64();
+
+    let reference_start = Instant::now();
+    let reference_steps = opts.reference_periods as u64 * opts.period_steps;
+    for period in 0..opts.reference_periods {
+        let done = period as u64 * opts.period_steps;
+        sim.run(opts.period_steps, REPORT_EVERY, &mut |s| {
+            progress(Phase::Reference, done + s, reference_steps)
+        })?;
+        writer.write_snapshot(&sim.snapshot(period + 2))?;
+    }
+    let costs = RecordingCosts {
+        seconds_to_t0,
+        seconds_period,
+        seconds_reference: reference_start.elapsed().as_secs_f64(),
+        seconds_recorder: recorder_seconds,
+        stage_seconds: sim
+            .counters
+            .stages()
+            .iter()
+            .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
+            .collect(),
+        threads: rayon::current_num_threads(),
+    };
+    Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+}
+
+fn recording_info(
+    sim: &Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    opts: &RecordOptions,
+) -> RecordingInfo {
+    let case = &sim.case;
+    let particles = sim.particles.len() as u32;
+    let r_max = sim.particles.radius.iter().cloned().fold(0.0, f64::max);
+    let kinds = ["mantle", "cap_low", "cap_high"];
+    RecordingInfo {
+        format_version: FORMAT_VERSION,
+        tool_version: env!("CARGO_PKG_VERSION").into(),
+        case_toml: case_toml.into(),
+        case_path: case_path.display().to_string(),
+        case_resolved: serde_json::to_value(case).expect("a case serialises"),
+        particles,
+        walls: (0..sim.walls.len())
+            .map(|w| WallInfo {
+                id: particles + w as u32,
+                kind: kinds.get(w).copied().unwrap_or("wall").into(),
+                temperature: sim.walls.temperature(w),
+            })
+            .collect(),
+        dt: sim.params.dt,
+        sample_every: opts.sample_every,
+        dtc_max_steps: opts.dtc_max_steps,
+        period_steps: opts.period_steps,
+        tau: opts.period_steps as f64 * sim.params.dt,
+        t0: sim.time,
+        step_t0: sim.step,
+        reference_periods: opts.reference_periods,
+        area_encoding: opts.area_encoding,
+        sqrt_area_unit: match opts.area_encoding {
+            AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * r_max / SQRT_AREA_CODES,
+            AreaEncoding::Exact => 0.0,
+        },
+        pair_conductivity: sim.params.conduction.pair_conductivity,
+        wall_conductivity: sim.params.conduction.wall_conductivity,
+        density: case.material.density,
+        heat_capacity: case.material.heat_capacity,
+        conductivity: case.material.conductivity,
+    }
+}

@@ -1,0 +1,131 @@
+//! `tdex record`: the recording stage with a progress bar and a summary of what was written.
+
+use crate::cli::RecordPlan;
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use recorder::format::RecordingReader;
+use recorder::record::{self, Phase};
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// `tdex record --json` (keys documented in docs/user-guide.md).
+#[derive(Debug, Serialize)]
+struct RecordReport {
+    output: String,
+    case: String,
+    particles: u32,
+    threads: usize,
+    dt: f64,
+    n: u32,
+    dtc_max_steps: u32,
+    tau: f64,
+    period_steps: u64,
+    t0: f64,
+    reference_periods: u32,
+    rows: u64,
+    wall_rows: u64,
+    file_bytes: u64,
+    table_bytes: u64,
+    bytes_per_row: f64,
+    seconds_to_t0: f64,
+    seconds_period: f64,
+    seconds_recorder: f64,
+    seconds_reference: f64,
+    stage_seconds: BTreeMap<String, f64>,
+}
+
+pub fn run(plan: &RecordPlan) -> Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(plan.threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let bar = if plan.json {
+        ProgressBar::hidden()
+    } else {
+        let bar = ProgressBar::new(1);
+        bar.set_style(
+            ProgressStyle::with_template("{msg:>9} [{bar:40}] {pos}/{len} steps ({eta} left)")
+                .expect("static template")
+                .progress_chars("=> "),
+        );
+        bar
+    };
+    let mut progress = |phase: Phase, done: u64, total: u64| {
+        let name = match phase {
+            Phase::Settle => "settle",
+            Phase::SpinUp => "spin-up",
+            Phase::Period => "record",
+            Phase::Reference => "reference",
+        };
+        if bar.message() != name {
+            bar.set_message(name);
+            bar.set_length(total);
+            bar.reset_eta();
+        }
+        bar.set_position(done);
+    };
+    pool.install(|| {
+        record::record(
+            &plan.case,
+            &plan.case_path,
+            &plan.case_toml,
+            &plan.options,
+            &plan.output,
+            &mut progress,
+        )
+    })
+    .with_context(|| format!("recording case {}", plan.case_path.display()))?;
+    bar.finish_and_clear();
+
+    let reader = RecordingReader::open(&plan.output)?;
+    let info = reader.info();
+    let summary = reader.summary().expect("written by finish");
+    let costs = reader.costs().expect("written by finish");
+    let report = RecordReport {
+        output: plan.output.display().to_string(),
+        case: plan.case.name.clone(),
+        particles: info.particles,
+        threads: costs.threads,
+        dt: info.dt,
+        n: info.sample_every,
+        dtc_max_steps: info.dtc_max_steps,
+        tau: info.tau,
+        period_steps: info.period_steps,
+        t0: info.t0,
+        reference_periods: info.reference_periods,
+        rows: summary.rows,
+        wall_rows: summary.wall_rows,
+        file_bytes: reader.file_bytes(),
+        table_bytes: reader.table_bytes(),
+        bytes_per_row: reader.table_bytes() as f64 / summary.rows.max(1) as f64,
+        seconds_to_t0: costs.seconds_to_t0,
+        seconds_period: costs.seconds_period,
+        seconds_recorder: costs.seconds_recorder,
+        seconds_reference: costs.seconds_reference,
+        stage_seconds: costs.stage_seconds.clone(),
+    };
+    if plan.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!(
+            "recording     {} ({} particles, case {})",
+            report.output, report.particles, report.case
+        );
+        println!(
+            "period        τ = {} s ({} steps of {:e} s) from t0 = {} s; n = {}, Δt_c^max = {} steps",
+            report.tau, report.period_steps, report.dt, report.t0, report.n, report.dtc_max_steps
+        );
+        println!(
+            "table         {} rows ({} wall rows), {:.2} bytes per row, file {:.1} MB",
+            report.rows,
+            report.wall_rows,
+            report.bytes_per_row,
+            report.file_bytes as f64 / 1e6
+        );
+        println!(
+            "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
+            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.reference_periods
+        );
+    }
+    Ok(())
+}
