@@ -1,6 +1,7 @@
 //! tdex command line: parse flags, validate them into a plan before any work, run, and map
 //! errors to an exit code (2: bad input, 1: the run failed).
 
+mod bench;
 mod cli;
 mod inspect;
 mod record;
@@ -14,6 +15,7 @@ fn main() -> ExitCode {
         cli::Plan::Run(p) => run::run(&p),
         cli::Plan::Record(p) => record::run(&p),
         cli::Plan::Inspect(p) => inspect::run(&p),
+        cli::Plan::BenchRecord(p) => bench::record(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

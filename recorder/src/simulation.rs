@@ -49,6 +49,7 @@ pub struct HeatSummary {
     pub cold_mean: Option<f64>,
 }
 
+#[derive(Clone)]
 pub struct Simulation {
     pub case: Case,
     pub params: StepParams,

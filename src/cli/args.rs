@@ -60,12 +60,43 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Benchmarks (figures for docs/benchmarks.md).
+    #[command(subcommand)]
+    Bench(BenchCommand),
     /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
     /// suggested n, costs. Reads the whole table, so it also checks the file.
     Inspect {
         /// The recording (MCAP).
         file: PathBuf,
         /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum BenchCommand {
+    /// Recording overhead: from one state at t0, time the period plain and recorded; report
+    /// the ratio and the bytes per row of the table.
+    Record {
+        /// The case file (TOML).
+        case: PathBuf,
+        /// Period τ as a fraction of a drum revolution.
+        #[arg(long = "tau-rev", default_value_t = 1.0)]
+        tau_rev: f64,
+        /// Sampling factor n.
+        #[arg(long = "n", default_value_t = 10)]
+        n: u32,
+        /// Δt_c^max in DEM steps.
+        #[arg(long = "dtc-max", default_value_t = 100)]
+        dtc_max: u32,
+        /// Plain/recorded pairs to run (the fastest of each is reported).
+        #[arg(long, default_value_t = 1)]
+        repeats: u32,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
     },

@@ -4,4 +4,4 @@ mod args;
 mod plan;
 
 pub use args::Cli;
-pub use plan::{InspectPlan, Plan, RecordPlan, RunPlan, UsageError};
+pub use plan::{BenchRecordPlan, InspectPlan, Plan, RecordPlan, RunPlan, UsageError};

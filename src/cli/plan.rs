@@ -1,6 +1,6 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
-use super::args::{Cli, Command};
+use super::args::{BenchCommand, Cli, Command};
 use anyhow::Result;
 use recorder::format::AreaEncoding;
 use recorder::record::RecordOptions;
@@ -23,6 +23,17 @@ pub enum Plan {
     Run(RunPlan),
     Record(RecordPlan),
     Inspect(InspectPlan),
+    BenchRecord(BenchRecordPlan),
+}
+
+pub struct BenchRecordPlan {
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub options: RecordOptions,
+    pub repeats: u32,
+    pub threads: usize,
+    pub json: bool,
 }
 
 pub struct RecordPlan {
@@ -101,6 +112,32 @@ impl Plan {
                 }))
             }
             Command::Inspect { file, json } => Ok(Plan::Inspect(InspectPlan { file, json })),
+            Command::Bench(BenchCommand::Record {
+                case,
+                tau_rev,
+                n,
+                dtc_max,
+                repeats,
+                threads: t,
+                json,
+            }) => {
+                let threads = threads(t)?;
+                if repeats == 0 {
+                    return Err(usage("--repeats = 0 is not allowed: give at least 1".into()));
+                }
+                let loaded = recorder::case::load(&case)?;
+                let case_toml = std::fs::read_to_string(&case)?;
+                let options = record_options(&loaded, None, Some(tau_rev), n, dtc_max, 0, false)?;
+                Ok(Plan::BenchRecord(BenchRecordPlan {
+                    case_path: case,
+                    case_toml,
+                    case: loaded,
+                    options,
+                    repeats,
+                    threads,
+                    json,
+                }))
+            }
         }
     }
 }

@@ -56,37 +56,57 @@ pub fn record(
     dest: &Path,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<RecordingSummary, RecordError> {
-    let mut sampler =
-        ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
-            RecordError::Settings(format!(
-                "Δt_c^max = {} steps must be a positive multiple of n = {}",
-                opts.dtc_max_steps, opts.sample_every
-            ))
-        })?;
+    check(opts)?;
+    let started = Instant::now();
+    let mut sim = run_to_t0(case, progress)?;
+    let seconds_to_t0 = started.elapsed().as_secs_f64();
+    record_from_t0(&mut sim, case_path, case_toml, opts, dest, seconds_to_t0, progress)
+}
+
+fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
     let every = opts.sample_every as u64;
-    if opts.period_steps == 0 || opts.period_steps % every != 0 {
+    if every == 0 || opts.period_steps == 0 || opts.period_steps % every != 0 {
         return Err(RecordError::Settings(format!(
             "τ = {} steps must be a positive multiple of n = {every}",
             opts.period_steps
         )));
     }
-    let started = Instant::now();
-    let mut sim = Simulation::new(case)?;
-    let (n_settle, n_spin) = (
-        case.steps_in(case.time.settle),
-        case.steps_in(case.time.spin_up),
-    );
-    sim.run(n_settle, REPORT_EVERY, &mut |s| {
-        progress(Phase::Settle, s, n_settle)
-    })?;
-    sim.start_rotation();
-    sim.run(n_spin, REPORT_EVERY, &mut |s| {
-        progress(Phase::SpinUp, s, n_spin)
-    })?;
-    sim.assign_temperatures();
-    let seconds_to_t0 = started.elapsed().as_secs_f64();
+    ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
+        RecordError::Settings(format!(
+            "Δt_c^max = {} steps must be a positive multiple of n = {}",
+            opts.dtc_max_steps, opts.sample_every
+        ))
+    })
+}
 
-    let info = recording_info(&sim, case_path, case_toml, opts);
+/// Inserts, settles and spins the drum up to `t0`, then assigns the initial temperatures.
+pub fn run_to_t0(
+    case: &Case,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Simulation, SimulationError> {
+    let mut sim = Simulation::new(case)?;
+    let (n_settle, n_spin) = (case.steps_in(case.time.settle), case.steps_in(case.time.spin_up));
+    sim.run(n_settle, REPORT_EVERY, &mut |s| progress(Phase::Settle, s, n_settle))?;
+    sim.start_rotation();
+    sim.run(n_spin, REPORT_EVERY, &mut |s| progress(Phase::SpinUp, s, n_spin))?;
+    sim.assign_temperatures();
+    Ok(sim)
+}
+
+/// Records the period `[t0, t1]` of a simulation standing at `t0` (and the reference
+/// periods) into `dest`.
+pub fn record_from_t0(
+    sim: &mut Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    opts: &RecordOptions,
+    dest: &Path,
+    seconds_to_t0: f64,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let mut sampler = check(opts)?;
+    let every = opts.sample_every as u64;
+    let info = recording_info(sim, case_path, case_toml, opts);
     let mut writer = RecordingWriter::create(dest, info)?;
     writer.write_snapshot(&sim.snapshot(0))?;
 

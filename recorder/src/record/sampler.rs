@@ -4,7 +4,7 @@
 
 use super::CollisionRow;
 use rustc_hash::FxHashMap;
-use std::collections::BTreeMap;
+use std::collections::VecDeque;
 
 /// A contact seen at the previous sample, with its row in progress.
 #[derive(Debug, Clone, Copy)]
@@ -19,9 +19,37 @@ struct OpenContact {
     collision_samples: u32,
 }
 
+/// Rows by apparition rank, from the oldest not yet released: `None` while in progress.
+/// Spans at most the rows started within `Δt_c^max`, since no row stays open longer.
+#[derive(Debug, Clone, Default)]
+struct RowWindow {
+    /// Rank of `slots[0]`.
+    base: u64,
+    slots: VecDeque<Option<CollisionRow>>,
+}
+
+impl RowWindow {
+    /// Reserves the next rank for a row that has just started.
+    fn start(&mut self) -> u64 {
+        self.slots.push_back(None);
+        self.base + self.slots.len() as u64 - 1
+    }
+
+    fn complete(&mut self, seq: u64, row: CollisionRow) {
+        self.slots[(seq - self.base) as usize] = Some(row);
+    }
+
+    /// Releases the leading completed rows.
+    fn drain_completed(&mut self) -> Vec<CollisionRow> {
+        let ready = self.slots.iter().take_while(|s| s.is_some()).count();
+        self.base += ready as u64;
+        self.slots.drain(..ready).map(|s| s.expect("completed")).collect()
+    }
+}
+
 impl OpenContact {
-    /// Ends the row in progress (if it has samples) into `done`, keyed by its apparition rank.
-    fn close_row(&mut self, key: (u32, u32), every: u32, done: &mut BTreeMap<u64, CollisionRow>) {
+    /// Ends the row in progress (if it has samples) into its slot of the window.
+    fn close_row(&mut self, key: (u32, u32), every: u32, done: &mut RowWindow) {
         if self.samples > 0 {
             let row = CollisionRow {
                 i: key.0,
@@ -30,7 +58,7 @@ impl OpenContact {
                 duration_steps: self.samples * every,
                 sqrt_area: self.sqrt_area_sum / self.samples as f64,
             };
-            done.insert(self.seq, row);
+            done.complete(self.seq, row);
             self.samples = 0;
             self.sqrt_area_sum = 0.0;
         }
@@ -46,9 +74,8 @@ pub struct ContactSampler {
     pub max_duration: u32,
     /// Open contacts by pair; Fx hashing because the map is probed once per contact per sample.
     open: FxHashMap<(u32, u32), OpenContact>,
-    /// Completed rows not yet released, keyed by apparition rank.
-    done: BTreeMap<u64, CollisionRow>,
-    next_seq: u64,
+    /// Rows not yet released, in apparition order.
+    done: RowWindow,
     /// Step of the last sample, if any.
     last_sample: Option<u64>,
     /// `histogram[s]`: ended collisions seen at `s` consecutive samples.
@@ -65,8 +92,7 @@ impl ContactSampler {
             every,
             max_duration,
             open: FxHashMap::default(),
-            done: BTreeMap::new(),
-            next_seq: 0,
+            done: RowWindow::default(),
             last_sample: None,
             histogram: Vec::new(),
         })
@@ -86,7 +112,6 @@ impl ContactSampler {
         let full_row = self.max_duration / self.every;
         for (a, b, sqrt_area) in contacts {
             let key = (a.min(b), a.max(b));
-            let next_seq = &mut self.next_seq;
             let c = self.open.entry(key).or_insert_with(|| OpenContact {
                 row_start: step,
                 samples: 0,
@@ -97,8 +122,7 @@ impl ContactSampler {
             });
             if c.samples == 0 {
                 c.row_start = step;
-                c.seq = *next_seq;
-                *next_seq += 1;
+                c.seq = self.done.start();
             }
             c.samples += 1;
             c.collision_samples += 1;
@@ -129,16 +153,7 @@ impl ContactSampler {
 
     /// Rows that can no longer be preceded by another, in apparition order.
     pub fn drain_ready(&mut self) -> Vec<CollisionRow> {
-        let oldest_open = self
-            .open
-            .values()
-            .filter(|c| c.samples > 0)
-            .map(|c| c.seq)
-            .min()
-            .unwrap_or(u64::MAX);
-        let later = self.done.split_off(&oldest_open);
-        let ready = std::mem::replace(&mut self.done, later);
-        ready.into_values().collect()
+        self.done.drain_completed()
     }
 
     /// Ends the period: contacts still open are cut, and every remaining row is returned.
@@ -147,7 +162,9 @@ impl ContactSampler {
             c.close_row(key, self.every, &mut self.done);
             count(&mut self.histogram, c.collision_samples);
         }
-        std::mem::take(&mut self.done).into_values().collect()
+        let rows = self.done.drain_completed();
+        debug_assert!(self.done.slots.is_empty());
+        rows
     }
 }
 
