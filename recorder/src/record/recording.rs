@@ -9,6 +9,7 @@ use crate::format::{
 };
 use crate::{Simulation, SimulationError};
 use std::path::Path;
+use std::sync::mpsc;
 use std::time::Instant;
 
 /// What to record, validated by the caller (the CLI plan).
@@ -104,31 +105,16 @@ pub fn record_from_t0(
     seconds_to_t0: f64,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<RecordingSummary, RecordError> {
-    let mut sampler = check(opts)?;
-    let every = opts.sample_every as u64;
+    let sampler = check(opts)?;
     let info = recording_info(sim, case_path, case_toml, opts);
     let mut writer = RecordingWriter::create(dest, info)?;
     writer.write_snapshot(&sim.snapshot(0))?;
 
     let period_start = Instant::now();
-    let mut recorder_seconds = 0.0;
-    let mut k = 0;
-    while k < opts.period_steps {
-        let t = Instant::now();
-        // the contact list at t0 + k dt, as computed by the step that ended there
-        sampler.sample(k, sim.touching_pairs().chain(sim.touching_walls()));
-        writer.push_rows(sampler.drain_ready())?;
-        recorder_seconds += t.elapsed().as_secs_f64();
-        sim.run(every, every, &mut |_| {})?;
-        k += every;
-        if k % REPORT_EVERY < every || k == opts.period_steps {
-            progress(Phase::Period, k, opts.period_steps);
-        }
-    }
+    let (sampler, recorder_seconds) = record_period(sim, sampler, &mut writer, opts, progress)?;
     let t = Instant::now();
-    writer.push_rows(sampler.finish())?;
     writer.write_snapshot(&sim.snapshot(1))?;
-    recorder_seconds += t.elapsed().as_secs_f64();
+    let recorder_seconds = recorder_seconds + t.elapsed().as_secs_f64();
     let seconds_period = period_start.elapsed().as_secs_f64();
 
     let reference_start = Instant::now();
@@ -154,6 +140,65 @@ pub fn record_from_t0(
         threads: rayon::current_num_threads(),
     };
     Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+}
+
+/// Contact lists in flight between the DEM and the recorder thread.
+const SAMPLES_IN_FLIGHT: usize = 4;
+
+/// The period `[t0, t1]`: the DEM steps on the calling thread (and its pool) while a recorder
+/// thread samples, splits, encodes and writes. Each sample is the contact list copied at its
+/// step, so the table is the same as a serial recorder's, whatever the timing; the recorder
+/// fills the cores the DEM leaves idle instead of stalling it. Returns the finished sampler
+/// (for its histogram) and the recorder thread's busy seconds.
+fn record_period(
+    sim: &mut Simulation,
+    mut sampler: ContactSampler,
+    writer: &mut RecordingWriter,
+    opts: &RecordOptions,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<(ContactSampler, f64), RecordError> {
+    type Sample = Vec<(u32, u32, f64)>;
+    let every = opts.sample_every as u64;
+    let (to_recorder, samples) = mpsc::sync_channel::<(u64, Sample)>(SAMPLES_IN_FLIGHT);
+    let (to_dem, spare) = mpsc::channel::<Sample>();
+    std::thread::scope(|scope| {
+        let recorder = scope.spawn(move || -> Result<(ContactSampler, f64), FormatError> {
+            let mut busy = 0.0;
+            for (step, contacts) in samples {
+                let t = Instant::now();
+                sampler.sample(step, contacts.iter().copied());
+                writer.push_rows(sampler.drain_ready())?;
+                let _ = to_dem.send(contacts);
+                busy += t.elapsed().as_secs_f64();
+            }
+            let t = Instant::now();
+            writer.push_rows(sampler.finish())?;
+            Ok((sampler, busy + t.elapsed().as_secs_f64()))
+        });
+        let mut dem = || -> Result<(), RecordError> {
+            let mut k = 0;
+            while k < opts.period_steps {
+                // the contact list at t0 + k dt, as computed by the step that ended there
+                let mut contacts = spare.try_recv().unwrap_or_default();
+                contacts.clear();
+                contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
+                if to_recorder.send((k, contacts)).is_err() {
+                    return Ok(()); // the recorder stopped: its error is reported below
+                }
+                sim.run(every, every, &mut |_| {})?;
+                k += every;
+                if k % REPORT_EVERY < every || k == opts.period_steps {
+                    progress(Phase::Period, k, opts.period_steps);
+                }
+            }
+            Ok(())
+        };
+        let dem_result = dem();
+        drop(to_recorder);
+        let recorded = recorder.join().expect("the recorder thread does not panic");
+        dem_result?;
+        Ok(recorded?)
+    })
 }
 
 fn recording_info(
