@@ -63,7 +63,10 @@ fn bench_record(plan: &BenchRecordPlan) -> Result<()> {
         let t = Instant::now();
         sim.run(steps, 10_000, &mut |_| {})?;
         plain.push(t.elapsed().as_secs_f64());
-        say(format!("  round {round}: plain period {:.2} s", plain.last().unwrap()));
+        say(format!(
+            "  round {round}: plain period {:.2} s",
+            plain.last().unwrap()
+        ));
         let mut sim = at_t0.clone();
         let t = Instant::now();
         record::record_from_t0(
@@ -78,7 +81,10 @@ fn bench_record(plan: &BenchRecordPlan) -> Result<()> {
         recorded.push(t.elapsed().as_secs_f64());
         let reader = RecordingReader::open(&out)?;
         recorder_seconds = recorder_seconds.min(reader.costs().map_or(0.0, |c| c.seconds_recorder));
-        say(format!("  round {round}: recorded period {:.2} s", recorded.last().unwrap()));
+        say(format!(
+            "  round {round}: recorded period {:.2} s",
+            recorded.last().unwrap()
+        ));
     }
     let reader = RecordingReader::open(&out)?;
     let rows = reader.summary().map_or(0, |s| s.rows);

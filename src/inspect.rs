@@ -38,6 +38,34 @@ struct WorstRow {
     cfl: f64,
 }
 
+/// How a recording was sampled; shared by the `record` and `inspect` reports.
+#[derive(Debug, Serialize)]
+pub struct Sampling {
+    pub particles: u32,
+    pub dt: f64,
+    pub n: u32,
+    pub dtc_max_steps: u32,
+    pub tau: f64,
+    pub period_steps: u64,
+    pub t0: f64,
+    pub reference_periods: u32,
+}
+
+impl Sampling {
+    pub fn of(info: &recorder::format::RecordingInfo) -> Self {
+        Self {
+            particles: info.particles,
+            dt: info.dt,
+            n: info.sample_every,
+            dtc_max_steps: info.dtc_max_steps,
+            tau: info.tau,
+            period_steps: info.period_steps,
+            t0: info.t0,
+            reference_periods: info.reference_periods,
+        }
+    }
+}
+
 /// `tdex inspect --json` (keys documented in docs/user-guide.md).
 #[derive(Debug, Serialize)]
 struct Inspection {
@@ -46,16 +74,10 @@ struct Inspection {
     format_version: u32,
     tool_version: String,
     case: String,
-    particles: u32,
+    #[serde(flatten)]
+    sampling: Sampling,
     walls: usize,
     conducting_walls: usize,
-    dt: f64,
-    n: u32,
-    dtc_max_steps: u32,
-    tau: f64,
-    period_steps: u64,
-    t0: f64,
-    reference_periods: u32,
     area_encoding: String,
     rows: u64,
     wall_rows: u64,
@@ -158,20 +180,13 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
             .and_then(|v| v.as_str())
             .unwrap_or("")
             .into(),
-        particles: info.particles,
+        sampling: Sampling::of(&info),
         walls: info.walls.len(),
         conducting_walls: info
             .walls
             .iter()
             .filter(|w| w.temperature.is_some())
             .count(),
-        dt: info.dt,
-        n: info.sample_every,
-        dtc_max_steps: info.dtc_max_steps,
-        tau: info.tau,
-        period_steps: info.period_steps,
-        t0: info.t0,
-        reference_periods: info.reference_periods,
         area_encoding: format!("{:?}", info.area_encoding).to_lowercase(),
         rows,
         wall_rows,
@@ -221,15 +236,19 @@ fn print_human(s: &Inspection) {
     );
     println!(
         "case          {}: {} particles, {} walls ({} conducting)",
-        s.case, s.particles, s.walls, s.conducting_walls
+        s.case, s.sampling.particles, s.walls, s.conducting_walls
     );
     println!(
         "period        τ = {} s = {} steps of {:e} s from t0 = {} s; {} reference periods",
-        s.tau, s.period_steps, s.dt, s.t0, s.reference_periods
+        s.sampling.tau,
+        s.sampling.period_steps,
+        s.sampling.dt,
+        s.sampling.t0,
+        s.sampling.reference_periods
     );
     println!(
         "sampling      n = {} steps, Δt_c^max = {} steps, sqrt(a) {}",
-        s.n, s.dtc_max_steps, s.area_encoding
+        s.sampling.n, s.sampling.dtc_max_steps, s.area_encoding
     );
     println!(
         "table         {} rows ({} wall rows) in {} batches, {} contact-steps; {:.2} bytes per row ({:.1} MB)",

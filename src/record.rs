@@ -1,6 +1,7 @@
 //! `tdex record`: the recording stage with a progress bar and a summary of what was written.
 
 use crate::cli::RecordPlan;
+use crate::inspect::Sampling;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use recorder::format::RecordingReader;
@@ -13,15 +14,9 @@ use std::collections::BTreeMap;
 struct RecordReport {
     output: String,
     case: String,
-    particles: u32,
+    #[serde(flatten)]
+    sampling: Sampling,
     threads: usize,
-    dt: f64,
-    n: u32,
-    dtc_max_steps: u32,
-    tau: f64,
-    period_steps: u64,
-    t0: f64,
-    reference_periods: u32,
     rows: u64,
     wall_rows: u64,
     file_bytes: u64,
@@ -84,15 +79,8 @@ pub fn run(plan: &RecordPlan) -> Result<()> {
     let report = RecordReport {
         output: plan.output.display().to_string(),
         case: plan.case.name.clone(),
-        particles: info.particles,
+        sampling: Sampling::of(info),
         threads: costs.threads,
-        dt: info.dt,
-        n: info.sample_every,
-        dtc_max_steps: info.dtc_max_steps,
-        tau: info.tau,
-        period_steps: info.period_steps,
-        t0: info.t0,
-        reference_periods: info.reference_periods,
         rows: summary.rows,
         wall_rows: summary.wall_rows,
         file_bytes: reader.file_bytes(),
@@ -109,11 +97,11 @@ pub fn run(plan: &RecordPlan) -> Result<()> {
     } else {
         println!(
             "recording     {} ({} particles, case {})",
-            report.output, report.particles, report.case
+            report.output, report.sampling.particles, report.case
         );
         println!(
             "period        τ = {} s ({} steps of {:e} s) from t0 = {} s; n = {}, Δt_c^max = {} steps",
-            report.tau, report.period_steps, report.dt, report.t0, report.n, report.dtc_max_steps
+            report.sampling.tau, report.sampling.period_steps, report.sampling.dt, report.sampling.t0, report.sampling.n, report.sampling.dtc_max_steps
         );
         println!(
             "table         {} rows ({} wall rows), {:.2} bytes per row, file {:.1} MB",
@@ -124,7 +112,7 @@ pub fn run(plan: &RecordPlan) -> Result<()> {
         );
         println!(
             "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
-            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.reference_periods
+            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
         );
     }
     Ok(())

@@ -123,7 +123,9 @@ impl Plan {
             }) => {
                 let threads = threads(t)?;
                 if repeats == 0 {
-                    return Err(usage("--repeats = 0 is not allowed: give at least 1".into()));
+                    return Err(usage(
+                        "--repeats = 0 is not allowed: give at least 1".into(),
+                    ));
                 }
                 let loaded = recorder::case::load(&case)?;
                 let case_toml = std::fs::read_to_string(&case)?;

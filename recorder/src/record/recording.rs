@@ -61,7 +61,15 @@ pub fn record(
     let started = Instant::now();
     let mut sim = run_to_t0(case, progress)?;
     let seconds_to_t0 = started.elapsed().as_secs_f64();
-    record_from_t0(&mut sim, case_path, case_toml, opts, dest, seconds_to_t0, progress)
+    record_from_t0(
+        &mut sim,
+        case_path,
+        case_toml,
+        opts,
+        dest,
+        seconds_to_t0,
+        progress,
+    )
 }
 
 fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
@@ -86,10 +94,17 @@ pub fn run_to_t0(
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<Simulation, SimulationError> {
     let mut sim = Simulation::new(case)?;
-    let (n_settle, n_spin) = (case.steps_in(case.time.settle), case.steps_in(case.time.spin_up));
-    sim.run(n_settle, REPORT_EVERY, &mut |s| progress(Phase::Settle, s, n_settle))?;
+    let (n_settle, n_spin) = (
+        case.steps_in(case.time.settle),
+        case.steps_in(case.time.spin_up),
+    );
+    sim.run(n_settle, REPORT_EVERY, &mut |s| {
+        progress(Phase::Settle, s, n_settle)
+    })?;
     sim.start_rotation();
-    sim.run(n_spin, REPORT_EVERY, &mut |s| progress(Phase::SpinUp, s, n_spin))?;
+    sim.run(n_spin, REPORT_EVERY, &mut |s| {
+        progress(Phase::SpinUp, s, n_spin)
+    })?;
     sim.assign_temperatures();
     Ok(sim)
 }

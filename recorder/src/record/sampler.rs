@@ -43,7 +43,10 @@ impl RowWindow {
     fn drain_completed(&mut self) -> Vec<CollisionRow> {
         let ready = self.slots.iter().take_while(|s| s.is_some()).count();
         self.base += ready as u64;
-        self.slots.drain(..ready).map(|s| s.expect("completed")).collect()
+        self.slots
+            .drain(..ready)
+            .map(|s| s.expect("completed"))
+            .collect()
     }
 }
 
