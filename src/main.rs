@@ -3,7 +3,9 @@
 
 mod bench;
 mod cli;
+mod extrapolation;
 mod inspect;
+mod pair;
 mod record;
 mod run;
 
@@ -16,6 +18,8 @@ fn main() -> ExitCode {
         cli::Plan::Record(p) => record::run(&p),
         cli::Plan::Inspect(p) => inspect::run(&p),
         cli::Plan::BenchRecord(p) => bench::record(&p),
+        cli::Plan::Pair(p) => pair::run(&p),
+        cli::Plan::Extrapolate(p) => extrapolation::run(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -24,6 +28,8 @@ fn main() -> ExitCode {
             let bad_input = |e: &(dyn std::error::Error + 'static)| {
                 e.is::<recorder::CaseError>()
                     || e.is::<cli::UsageError>()
+                    || e.is::<extrapolate::replay::ReplayError>()
+                    || e.is::<extrapolate::pairing::PairingError>()
                     || e.downcast_ref::<recorder::format::FormatError>()
                         .is_some_and(|f| f.is_bad_input())
             };

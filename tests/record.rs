@@ -20,13 +20,13 @@ fn with_n_1_the_table_holds_exactly_the_dem_contact_time() {
         let mut sampler = ContactSampler::new(1, 100).unwrap();
         let (mut rows, mut dem_pair_steps) = (Vec::new(), 0u64);
         for k in 0..period {
-            // the contact list at t0 + k dt (computed by the step that ended there)
+            // the contact list of DEM step k (t0 + k dt → t0 + (k+1) dt), as the recorder samples it
+            sim.step();
             let pairs: Vec<_> = sim.touching_pairs().collect();
             assert_eq!(2 * pairs.len() as u64, sim.last_contacts.pair_entries);
             dem_pair_steps += pairs.len() as u64;
             sampler.sample(k, pairs);
             rows.extend(sampler.drain_ready());
-            sim.step();
         }
         rows.extend(sampler.finish());
         let table_steps: u64 = rows.iter().map(|r| r.duration_steps as u64).sum();

@@ -10,3 +10,4 @@ mod drum;
 mod physics_collision;
 mod physics_conduction;
 mod record;
+mod replay;

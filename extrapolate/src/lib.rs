@@ -1,1 +1,5 @@
-//! Pairing of the t0/t1 snapshots and replay of a recorded collision table (DESIGN.md §5–6; issue 4, not built yet).
+//! Pairing of the t0/t1 snapshots and replay of a recorded collision table (DESIGN.md §5–6;
+//! issue 4): [`pairing`] finds the roles, [`replay`] applies the table period after period.
+
+pub mod pairing;
+pub mod replay;

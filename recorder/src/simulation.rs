@@ -166,7 +166,8 @@ impl Simulation {
         Ok(())
     }
 
-    fn check_inside(&self) -> Result<(), SimulationError> {
+    /// Fails if a particle has left the drum (the sign of an unstable time step).
+    pub fn check_inside(&self) -> Result<(), SimulationError> {
         let (rd, half) = (self.case.drum.radius, 0.5 * self.case.drum.length);
         for (i, p) in self.particles.pos.iter().enumerate() {
             let rho2 = p[0] * p[0] + p[2] * p[2];

@@ -60,6 +60,43 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Pair the t0 and t1 snapshots of a recording (minimum total distance, certified
+    /// optimal) and store the pairing beside it (RECORDING.pairing.json) for reuse.
+    Pair {
+        /// The recording (MCAP).
+        file: PathBuf,
+        /// Worker threads (default: all cores). The pairing does not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Extrapolate K periods: replay the recorded table through the pairing, writing the
+    /// extrapolated temperature and position of every particle at every t_k (MCAP).
+    Extrapolate {
+        /// The recording (MCAP).
+        file: PathBuf,
+        /// Periods to extrapolate after t1.
+        #[arg(long)]
+        periods: u32,
+        /// The extrapolation to write (MCAP).
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// explicit (the paper's), exact (pairwise exponential relaxation, always stable) or
+        /// synchronous (rows with the same start at once, as the DEM).
+        #[arg(long, default_value = "explicit")]
+        scheme: String,
+        /// Read the table from the file every period instead of keeping it in memory.
+        #[arg(long)]
+        stream: bool,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
     /// Benchmarks (figures for docs/benchmarks.md).
     #[command(subcommand)]
     Bench(BenchCommand),

@@ -4,4 +4,6 @@ mod args;
 mod plan;
 
 pub use args::Cli;
-pub use plan::{BenchRecordPlan, InspectPlan, Plan, RecordPlan, RunPlan, UsageError};
+pub use plan::{
+    BenchRecordPlan, ExtrapolatePlan, InspectPlan, PairPlan, Plan, RecordPlan, RunPlan, UsageError,
+};

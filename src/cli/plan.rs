@@ -2,6 +2,7 @@
 
 use super::args::{BenchCommand, Cli, Command};
 use anyhow::Result;
+use extrapolate::replay::Scheme;
 use recorder::format::AreaEncoding;
 use recorder::record::RecordOptions;
 use recorder::Case;
@@ -24,6 +25,24 @@ pub enum Plan {
     Record(RecordPlan),
     Inspect(InspectPlan),
     BenchRecord(BenchRecordPlan),
+    Pair(PairPlan),
+    Extrapolate(ExtrapolatePlan),
+}
+
+pub struct PairPlan {
+    pub file: PathBuf,
+    pub threads: usize,
+    pub json: bool,
+}
+
+pub struct ExtrapolatePlan {
+    pub file: PathBuf,
+    pub periods: u32,
+    pub output: PathBuf,
+    pub scheme: Scheme,
+    pub stream: bool,
+    pub threads: usize,
+    pub json: bool,
 }
 
 pub struct BenchRecordPlan {
@@ -112,6 +131,44 @@ impl Plan {
                 }))
             }
             Command::Inspect { file, json } => Ok(Plan::Inspect(InspectPlan { file, json })),
+            Command::Pair {
+                file,
+                threads: t,
+                json,
+            } => Ok(Plan::Pair(PairPlan {
+                file,
+                threads: threads(t)?,
+                json,
+            })),
+            Command::Extrapolate {
+                file,
+                periods,
+                output,
+                scheme,
+                stream,
+                threads: t,
+                json,
+            } => {
+                let threads = threads(t)?;
+                if periods == 0 {
+                    return Err(usage(
+                        "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
+                    ));
+                }
+                let scheme: Scheme = scheme
+                    .parse()
+                    .map_err(|e: String| usage(format!("--scheme: {e}")))?;
+                check_output(&output)?;
+                Ok(Plan::Extrapolate(ExtrapolatePlan {
+                    file,
+                    periods,
+                    output,
+                    scheme,
+                    stream,
+                    threads,
+                    json,
+                }))
+            }
             Command::Bench(BenchCommand::Record {
                 case,
                 tau_rev,

@@ -1,12 +1,14 @@
 //! The recording file (MCAP, DESIGN.md §4; layout in docs/file-format.md): what a recording
 //! holds, the writer used by `tdex record` and the streaming reader used by `extrapolate`.
 
+pub mod extrapolation;
 pub mod proto;
 pub mod reader;
 pub mod snapshot;
 pub mod table;
 pub mod writer;
 
+pub use extrapolation::{ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter};
 pub use reader::RecordingReader;
 pub use snapshot::Snapshot;
 pub use table::TableBatch;

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 const CHUNK_BYTES: u64 = 8 << 20;
 
 pub struct RecordingWriter {
-    mcap: Option<mcap::Writer<BufWriter<File>>>,
+    mcap: Option<McapWriter>,
     info: RecordingInfo,
     dest: PathBuf,
     partial: PathBuf,
@@ -31,33 +31,12 @@ pub struct RecordingWriter {
 impl RecordingWriter {
     /// Starts a recording at `dest` (written to a hidden partial file until `finish`).
     pub fn create(dest: &Path, info: RecordingInfo) -> Result<Self, FormatError> {
-        let name = dest
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "recording.mcap".into());
-        let partial = dest.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-        let write_err = |error| FormatError::Write {
-            path: dest.to_path_buf(),
-            error,
-        };
-        let file = File::create(&partial).map_err(write_err)?;
+        let (mut mcap, partial) = open_partial(dest)?;
         let mcap_err = |error| FormatError::Mcap {
             path: dest.to_path_buf(),
             error,
         };
-        let mut mcap = mcap::WriteOptions::new()
-            .profile(PROFILE)
-            .library(format!("tdex {}", env!("CARGO_PKG_VERSION")))
-            .compression(Some(mcap::Compression::Zstd))
-            .chunk_size(Some(CHUNK_BYTES))
-            .create(BufWriter::with_capacity(1 << 20, file))
-            .map_err(mcap_err)?;
-        let json = serde_json::to_string(&info).expect("the info serialises");
-        mcap.write_metadata(&mcap::records::Metadata {
-            name: INFO_METADATA.into(),
-            metadata: BTreeMap::from([("json".to_string(), json)]),
-        })
-        .map_err(mcap_err)?;
+        write_json_metadata(&mut mcap, INFO_METADATA, &info).map_err(mcap_err)?;
         let snapshot_schema = mcap
             .add_schema("foxglove.PointCloud", "protobuf", POINT_CLOUD_DESCRIPTOR)
             .map_err(mcap_err)?;
@@ -200,32 +179,72 @@ impl RecordingWriter {
             path: dest.clone(),
             error,
         };
-        for (name, json) in [
-            (SUMMARY_METADATA, serde_json::to_string(&summary)),
-            (COSTS_METADATA, serde_json::to_string(costs)),
-        ] {
-            let metadata = mcap::records::Metadata {
-                name: name.into(),
-                metadata: BTreeMap::from([("json".to_string(), json.expect("serialisable"))]),
-            };
-            mcap.write_metadata(&metadata).map_err(mcap_err)?;
-        }
-        mcap.finish().map_err(mcap_err)?;
-        let file = mcap
-            .into_inner()
-            .into_inner()
-            .map_err(|e| FormatError::Write {
-                path: dest.clone(),
-                error: e.into_error(),
-            })?;
-        let write_err = |error| FormatError::Write {
-            path: dest.clone(),
-            error,
-        };
-        file.sync_all().map_err(write_err)?;
-        std::fs::rename(&self.partial, &self.dest).map_err(write_err)?;
+        write_json_metadata(&mut mcap, SUMMARY_METADATA, &summary).map_err(mcap_err)?;
+        write_json_metadata(&mut mcap, COSTS_METADATA, costs).map_err(mcap_err)?;
+        close_into_place(mcap, &self.partial, &self.dest)?;
         Ok(summary)
     }
+}
+
+/// A zstd-chunked MCAP writer on a hidden partial file beside `dest`.
+pub(crate) fn open_partial(dest: &Path) -> Result<(McapWriter, PathBuf), FormatError> {
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "tdex.mcap".into());
+    let partial = dest.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+    let file = File::create(&partial).map_err(|error| FormatError::Write {
+        path: dest.to_path_buf(),
+        error,
+    })?;
+    let mcap = mcap::WriteOptions::new()
+        .profile(PROFILE)
+        .library(format!("tdex {}", env!("CARGO_PKG_VERSION")))
+        .compression(Some(mcap::Compression::Zstd))
+        .chunk_size(Some(CHUNK_BYTES))
+        .create(BufWriter::with_capacity(1 << 20, file))
+        .map_err(|error| FormatError::Mcap {
+            path: dest.to_path_buf(),
+            error,
+        })?;
+    Ok((mcap, partial))
+}
+
+pub(crate) type McapWriter = mcap::Writer<BufWriter<File>>;
+
+/// A metadata record holding `value` as JSON under the key `json`.
+pub(crate) fn write_json_metadata(
+    mcap: &mut McapWriter,
+    name: &str,
+    value: &impl serde::Serialize,
+) -> Result<(), mcap::McapError> {
+    let json = serde_json::to_string(value).expect("tdex metadata serialises");
+    mcap.write_metadata(&mcap::records::Metadata {
+        name: name.into(),
+        metadata: BTreeMap::from([("json".to_string(), json)]),
+    })
+}
+
+/// Ends the MCAP file, syncs it and renames the partial file to `dest`.
+pub(crate) fn close_into_place(
+    mut mcap: McapWriter,
+    partial: &Path,
+    dest: &Path,
+) -> Result<(), FormatError> {
+    let write_err = |error| FormatError::Write {
+        path: dest.to_path_buf(),
+        error,
+    };
+    mcap.finish().map_err(|error| FormatError::Mcap {
+        path: dest.to_path_buf(),
+        error,
+    })?;
+    let file = mcap
+        .into_inner()
+        .into_inner()
+        .map_err(|e| write_err(e.into_error()))?;
+    file.sync_all().map_err(write_err)?;
+    std::fs::rename(partial, dest).map_err(write_err)
 }
 
 impl Drop for RecordingWriter {

@@ -193,14 +193,17 @@ fn record_period(
         let mut dem = || -> Result<(), RecordError> {
             let mut k = 0;
             while k < opts.period_steps {
-                // the contact list at t0 + k dt, as computed by the step that ended there
+                // sample k is the contact list that conducted during DEM step k, from
+                // t0 + k dt to t0 + (k+1) dt: the list the step has just computed
+                sim.step();
                 let mut contacts = spare.try_recv().unwrap_or_default();
                 contacts.clear();
                 contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
                 if to_recorder.send((k, contacts)).is_err() {
                     return Ok(()); // the recorder stopped: its error is reported below
                 }
-                sim.run(every, every, &mut |_| {})?;
+                sim.run(every - 1, every, &mut |_| {})?;
+                sim.check_inside()?;
                 k += every;
                 if k % REPORT_EVERY < every || k == opts.period_steps {
                     progress(Phase::Period, k, opts.period_steps);

@@ -1,0 +1,278 @@
+//! Optimality certificate against every pair left out of the candidate graph.
+//!
+//! The sparse solution is optimal on the candidate graph, with integer potentials
+//! `u` (rows, t1) and `v` (columns, t0) such that `c(p, q) − u[p] − v[q] >= 0` on every
+//! candidate edge and `= 0` on matched edges. If the same inequality holds for *all*
+//! n² pairs, LP duality makes the matching optimal for the complete problem.
+//!
+//! A pair (p, q) violates it iff `c(p, q) < u[p] + v[q]`. Costs and potentials are
+//! integers, so then `c <= u[p] + v[q] − 1`, and `c = round(d / unit) >= d / unit − 0.5`
+//! gives `d(p, q) <= (u[p] + v[q] − 0.5) · unit`. Writing `W_q = (v_max − v[q]) · unit
+//! >= 0`, a violator satisfies
+//!
+//! ```text
+//! d(p, q) + W_q <= (u[p] + v_max − 0.5) · unit   <   R_p = (u[p] + v_max + 0.5) · unit
+//! ```
+//!
+//! A plain radius query of radius `R_p` (i.e. `W_q` bounded below by 0) would already be
+//! sound, but potentials drift by tens of diameters across a long bed, which makes
+//! `R_p` useless. So the search is an additively weighted one on our own k-d tree over
+//! the t0 points whose nodes carry the minimum `W` of their subtree: a node is skipped
+//! when `mindist(p, box) + W_min >= R_p`, which by the inequality above cannot hide a
+//! violator. Every point that survives is tested exactly, on the integers. Candidate
+//! edges never test negative (the solver's invariant), so whatever fails the test is an
+//! excluded pair. `R_p` carries an extra relative margin for floating-point error.
+
+use rayon::prelude::*;
+
+use super::cost::CostScale;
+use super::sparse_lap::Lap;
+
+/// At most this many violating pairs per row are returned (the most negative reduced
+/// costs). Every violating row still gains an edge, so repair rounds still make
+/// progress, while a row on an expensive edge cannot flood the graph.
+pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
+/// Points per leaf of the weighted tree.
+const LEAF: usize = 16;
+/// Relative safety margin on `R_p` and the bounds: floating-point distances and the
+/// conversion of potentials to lengths err by ~1e-16 relative, far below this.
+const REL_MARGIN: f64 = 1e-9;
+
+#[derive(Clone, Debug)]
+struct Node {
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// Range of the node's points in the tree order.
+    start: u32,
+    end: u32,
+    /// Children (0 for a leaf: the root is never a child).
+    left: u32,
+    right: u32,
+}
+
+/// A static k-d tree over the t0 points (built once per pairing), with per-node minima
+/// of the weights `W` (refreshed for every certificate pass, as `v` changes).
+pub(crate) struct WeightedTree {
+    nodes: Vec<Node>,
+    /// Node minima of `W`, parallel to `nodes`.
+    wmin: Vec<f64>,
+    /// Points and their t0 indices, in tree order (leaves contiguous).
+    pts: Vec<[f64; 3]>,
+    idx: Vec<u32>,
+    /// Weights in tree order.
+    w: Vec<f64>,
+}
+
+impl WeightedTree {
+    /// Median splits on the widest axis of each box. Deterministic: the split uses
+    /// `select_nth_unstable_by` with a total order (coordinate, then index).
+    pub(crate) fn new(x0: &[[f64; 3]]) -> Self {
+        let mut idx: Vec<u32> = (0..x0.len() as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * x0.len() / LEAF + 2);
+        build(x0, &mut idx, 0, &mut nodes);
+        let pts = idx.iter().map(|&i| x0[i as usize]).collect();
+        let n = nodes.len();
+        Self {
+            nodes,
+            wmin: vec![0.0; n],
+            pts,
+            idx,
+            w: vec![0.0; x0.len()],
+        }
+    }
+
+    /// Loads `W_q = (v_max − v(q)) · unit` and recomputes the node minima.
+    fn set_weights(&mut self, v: impl Fn(usize) -> i64, v_max: i64, unit: f64) {
+        for (w, &q) in self.w.iter_mut().zip(&self.idx) {
+            *w = (v_max - v(q as usize)) as f64 * unit;
+        }
+        // Children come after their parent in `nodes`, so a reverse sweep is bottom-up.
+        for i in (0..self.nodes.len()).rev() {
+            let nd = &self.nodes[i];
+            self.wmin[i] = if nd.left == 0 {
+                self.w[nd.start as usize..nd.end as usize]
+                    .iter()
+                    .copied()
+                    .fold(f64::INFINITY, f64::min)
+            } else {
+                self.wmin[nd.left as usize].min(self.wmin[nd.right as usize])
+            };
+        }
+    }
+
+    /// Calls `visit(tree position)` for every point not excluded by the bound
+    /// `mindist(p, box) + W_min < r`, and for each of those points whose own
+    /// `d + W < r`. Returns nothing; `stack` is scratch.
+    fn search(&self, p: &[f64; 3], r: f64, stack: &mut Vec<u32>, mut visit: impl FnMut(usize)) {
+        stack.clear();
+        stack.push(0);
+        while let Some(i) = stack.pop() {
+            let i = i as usize;
+            let nd = &self.nodes[i];
+            if mindist(p, &nd.lo, &nd.hi) + self.wmin[i] >= r {
+                continue;
+            }
+            if nd.left == 0 {
+                for t in nd.start as usize..nd.end as usize {
+                    let d = super::cost::distance(p, &self.pts[t]);
+                    if d + self.w[t] < r {
+                        visit(t);
+                    }
+                }
+            } else {
+                stack.push(nd.right);
+                stack.push(nd.left);
+            }
+        }
+    }
+}
+
+fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>) -> u32 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for &i in idx.iter() {
+        let p = &x0[i as usize];
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let me = nodes.len();
+    nodes.push(Node {
+        lo,
+        hi,
+        start: offset as u32,
+        end: (offset + idx.len()) as u32,
+        left: 0,
+        right: 0,
+    });
+    if idx.len() > LEAF {
+        let axis = (0..3)
+            .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
+            .unwrap();
+        let mid = idx.len() / 2;
+        idx.select_nth_unstable_by(mid, |&a, &b| {
+            x0[a as usize][axis]
+                .total_cmp(&x0[b as usize][axis])
+                .then(a.cmp(&b))
+        });
+        let (l, r) = idx.split_at_mut(mid);
+        let left = build(x0, l, offset, nodes);
+        let right = build(x0, r, offset + mid, nodes);
+        nodes[me].left = left;
+        nodes[me].right = right;
+    }
+    me as u32
+}
+
+/// Distance from `p` to the box `[lo, hi]` (0 inside).
+#[inline]
+fn mindist(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
+    let mut s = 0.0;
+    for a in 0..3 {
+        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
+        s += d * d;
+    }
+    s.sqrt()
+}
+
+/// Outcome of one certificate pass.
+pub(crate) struct Check {
+    /// Violating pairs (row, column), sorted.
+    pub(crate) violations: Vec<(u32, u32)>,
+    /// How many pairs were tested exactly (work counter).
+    pub(crate) examined: u64,
+}
+
+/// One certificate pass (in parallel over rows, results collected in row order).
+/// `lap` must hold a perfect matching that satisfies the invariant on the current
+/// candidate graph.
+pub(crate) fn check(
+    tree: &mut WeightedTree,
+    x1: &[[f64; 3]],
+    lap: &Lap,
+    scale: &CostScale,
+) -> Check {
+    let v_max = (0..x1.len()).map(|q| lap.v(q)).max().unwrap_or(0);
+    let unit = scale.unit();
+    tree.set_weights(|q| lap.v(q), v_max, unit);
+    let tree = &*tree;
+    let per_row: Vec<(Vec<u32>, u64)> = (0..x1.len())
+        .into_par_iter()
+        .with_min_len(256)
+        .map_init(Vec::new, |stack, p| {
+            let u = lap.u(p);
+            if u + v_max <= 0 {
+                // c >= 0 and v <= v_max: nothing can undercut.
+                return (Vec::new(), 0);
+            }
+            let r = ((u + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
+            let mut bad: Vec<(i64, u32)> = Vec::new();
+            let mut examined = 0u64;
+            tree.search(&x1[p], r, stack, |t| {
+                examined += 1;
+                let q = tree.idx[t] as usize;
+                let reduced = scale.cost(&x1[p], &tree.pts[t]) - u - lap.v(q);
+                if reduced < 0 {
+                    bad.push((reduced, q as u32));
+                }
+            });
+            bad.sort_unstable();
+            bad.truncate(MAX_ADDED_PER_ROW);
+            let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
+            cols.sort_unstable();
+            (cols, examined)
+        })
+        .collect();
+    let mut violations = Vec::new();
+    let mut examined = 0;
+    for (p, (bad, m)) in per_row.into_iter().enumerate() {
+        examined += m;
+        violations.extend(bad.into_iter().map(|q| (p as u32, q)));
+    }
+    Check {
+        violations,
+        examined,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The weighted search returns exactly the brute-force set {q : d + W_q < r}.
+    #[test]
+    fn weighted_search_matches_brute_force() {
+        let mut s = 12345u64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let x0: Vec<[f64; 3]> = (0..700).map(|_| [rnd(), rnd(), 2.0 * rnd()]).collect();
+        let v: Vec<i64> = x0
+            .iter()
+            .map(|p| -((p[2] * 300.0) as i64) - (rnd() * 50.0) as i64)
+            .collect();
+        let v_max = *v.iter().max().unwrap();
+        let unit = 1e-3;
+        let mut tree = WeightedTree::new(&x0);
+        tree.set_weights(|q| v[q], v_max, unit);
+        let mut stack = Vec::new();
+        for _ in 0..50 {
+            let p = [rnd(), rnd(), 2.0 * rnd()];
+            let r = 0.05 + rnd() * 0.5;
+            let mut got = Vec::new();
+            tree.search(&p, r, &mut stack, |t| got.push(tree.idx[t]));
+            got.sort_unstable();
+            let want: Vec<u32> = (0..x0.len())
+                .filter(|&q| {
+                    super::super::cost::distance(&p, &x0[q]) + (v_max - v[q]) as f64 * unit < r
+                })
+                .map(|q| q as u32)
+                .collect();
+            assert_eq!(got, want);
+        }
+    }
+}

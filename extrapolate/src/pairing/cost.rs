@@ -1,0 +1,111 @@
+//! The integer objective shared by every solver: `cost(p, q) = round(|x1[p] − x0[q]| / unit)`.
+//!
+//! Both the dense oracle and the sparse solver minimise the sum of these integers, so
+//! "the sparse total equals the dense total" is an exact statement, not a tolerance.
+//! Integer costs also make the dual potentials integers, which is what lets the
+//! certificate decide optimality without any floating-point slack in the comparison.
+
+use super::PairingError;
+
+/// Largest cost (in units) we accept for a single pair. Keeps every cost exactly
+/// representable in an `f64` and leaves ample headroom in `i64` for sums and potentials.
+const MAX_PAIR_UNITS: f64 = (1u64 << 40) as f64;
+/// Bound on `n · max_pair_cost`: potentials and path lengths of the assignment solver
+/// are bounded by it, and it must stay far from `i64::MAX` (2^63).
+const MAX_TOTAL_UNITS: f64 = (1u64 << 60) as f64;
+
+/// Euclidean distance between two points (metres, or whatever the caller uses).
+#[inline]
+pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let dx = a[0] - b[0];
+    let dy = a[1] - b[1];
+    let dz = a[2] - b[2];
+    (dx * dx + dy * dy + dz * dz).sqrt()
+}
+
+/// The scaling from distances to integer costs, validated against the data extent.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct CostScale {
+    unit: f64,
+}
+
+impl CostScale {
+    /// Checks that `unit` is usable for these snapshots: finite, positive, and not so
+    /// small that the largest possible pair cost (the diagonal of the joint bounding box)
+    /// overflows the headroom the solver needs.
+    pub(crate) fn new(x0: &[[f64; 3]], x1: &[[f64; 3]], unit: f64) -> Result<Self, PairingError> {
+        if !(unit.is_finite() && unit > 0.0) {
+            return Err(PairingError::InvalidOption {
+                name: "unit",
+                reason: format!("must be finite and > 0, got {unit}"),
+            });
+        }
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in x0.iter().chain(x1) {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        // The diagonal bounds every pair distance; computed per axis first so that a
+        // huge extent shows up as infinity rather than silently wrapping.
+        let diag = distance(&lo, &hi);
+        let units = diag / unit;
+        let n = x0.len().max(1) as f64;
+        if !(units.is_finite() && units <= MAX_PAIR_UNITS && units * n <= MAX_TOTAL_UNITS) {
+            return Err(PairingError::CostOverflow {
+                extent: diag,
+                unit,
+                units,
+                max_units: MAX_PAIR_UNITS.min(MAX_TOTAL_UNITS / n),
+            });
+        }
+        Ok(Self { unit })
+    }
+
+    /// The length of one integer cost unit.
+    #[inline]
+    pub(crate) fn unit(&self) -> f64 {
+        self.unit
+    }
+
+    /// Integer cost of a distance: `round(d / unit)`, halves rounded away from zero.
+    /// Hence `cost >= d / unit − 0.5`, the inequality the certificate relies on.
+    #[inline]
+    pub(crate) fn cost_of_distance(&self, d: f64) -> i64 {
+        (d / self.unit).round() as i64
+    }
+
+    /// Integer cost of the pair (t1 point `a`, t0 point `b`).
+    #[inline]
+    pub(crate) fn cost(&self, a: &[f64; 3], b: &[f64; 3]) -> i64 {
+        self.cost_of_distance(distance(a, b))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_is_half_away_from_zero() {
+        let s = CostScale::new(&[[0.0; 3]], &[[10.0, 0.0, 0.0]], 1.0).unwrap();
+        assert_eq!(s.cost_of_distance(2.5), 3);
+        assert_eq!(s.cost_of_distance(2.4999), 2);
+        assert_eq!(s.cost(&[0.0; 3], &[3.0, 4.0, 0.0]), 5);
+    }
+
+    #[test]
+    fn rejects_units_that_overflow() {
+        let e = CostScale::new(&[[0.0; 3]], &[[1.0e9, 0.0, 0.0]], 1e-9).unwrap_err();
+        assert!(matches!(e, PairingError::CostOverflow { .. }), "{e}");
+        let e = CostScale::new(&[[0.0; 3]], &[[f64::MAX, 0.0, 0.0]], 1.0).unwrap_err();
+        assert!(matches!(e, PairingError::CostOverflow { .. }), "{e}");
+        let e = CostScale::new(&[[0.0; 3]], &[[0.0; 3]], 0.0).unwrap_err();
+        assert!(
+            matches!(e, PairingError::InvalidOption { name: "unit", .. }),
+            "{e}"
+        );
+    }
+}

@@ -1,0 +1,357 @@
+//! Pairing of the t0 and t1 snapshots (DESIGN.md §5; Haydar et al. 2023 §2.1.2,
+//! Bednarek et al. 2019): the bijection `g` that minimises `Σ_p |x1[p] − x0[g(p)]|`
+//! (Euclidean distance, not squared). At t1 particle `p` stands where `g(p)` stood at
+//! t0, so in the next period `p` plays the role of `g(p)`.
+//!
+//! Costs are integers, `round(|x1[p] − x0[q]| / unit)` (see [`PairingOptions::unit`]),
+//! so the sparse solver and the dense oracle minimise exactly the same objective.
+//!
+//! * [`pair_dense`] — Kuhn–Munkres on the full matrix; the oracle, small n only.
+//! * [`pair`] — the solver for real beds: shortest augmenting paths (Jonker–Volgenant,
+//!   Dijkstra on reduced costs) on the k nearest t0 neighbours of each t1 point; exit
+//!   edges added on Hall-violating sets while the candidate graph has no perfect
+//!   matching; then an optimality certificate against every excluded pair, through the
+//!   dual potentials (pairs it finds are added and the solve repeated, warm-started,
+//!   until it holds).
+//!
+//! Module map: `cost` (integer objective), `order` (Morton renumbering), `candidates`
+//! (kNN graph), `sparse_lap` (the solver), `feasibility` (Hopcroft–Karp, exit edges),
+//! `certificate` (weighted k-d tree search), `dense` (the oracle). The method and its
+//! soundness argument are written up in `docs/pairing.md`.
+
+mod candidates;
+mod certificate;
+mod cost;
+mod dense;
+mod feasibility;
+mod order;
+mod sparse_lap;
+
+use std::time::Instant;
+
+pub use dense::DENSE_LIMIT;
+
+/// Options of [`pair`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairingOptions {
+    /// Length of one integer cost unit, in the units of the coordinates. Pair costs are
+    /// `round(distance / unit)`: `unit = diameter · 1e-6` resolves distances to a
+    /// millionth of a particle diameter, far below any physical meaning, while keeping
+    /// costs small integers (≈ 6·10⁸ for the length of the paper's drum).
+    pub unit: f64,
+    /// Number of nearest t0 candidates per t1 point (≥ 1). If they admit no perfect
+    /// matching, exit edges are added on the Hall-violating sets (`growth_pairs`).
+    pub k_initial: usize,
+    /// Use the dense oracle when `n <= dense_max` (0: never). At most [`DENSE_LIMIT`].
+    pub dense_max: usize,
+    /// Run the optimality certificate (and repair until it holds). Without it the
+    /// result is optimal on the candidate graph only and `certified` is false.
+    pub certify: bool,
+}
+
+impl PairingOptions {
+    /// Defaults for particles of the given diameter: `unit = diameter · 1e-6`,
+    /// `k_initial = 12`, never dense, certified.
+    #[must_use]
+    pub fn for_diameter(diameter: f64) -> Self {
+        Self {
+            unit: diameter * 1e-6,
+            k_initial: 12,
+            dense_max: 0,
+            certify: true,
+        }
+    }
+}
+
+/// The optimal pairing and how it was obtained.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Pairing {
+    /// `g[p]`: the t0 index whose position particle `p` occupies at t1 (a permutation
+    /// of `0..n`).
+    pub g: Vec<u32>,
+    /// The minimised objective: `Σ_p round(|x1[p] − x0[g[p]]| / unit)`.
+    pub total_cost: i64,
+    /// `Σ_p |x1[p] − x0[g[p]]|`, in the units of the coordinates (summed in row order).
+    pub total_distance: f64,
+    /// Nearest t0 candidates per row in the kNN lists (`k_initial` capped at n); `n` for
+    /// the dense oracle. Growth adds individual edges, counted in `growth_pairs`.
+    pub k_used: usize,
+    /// True if the result is proven optimal for the complete problem (the dense oracle,
+    /// or the sparse solver with its certificate).
+    pub certified: bool,
+    /// Number of optimal solves on the candidate graph: 1 if the first solution was
+    /// certified at once; each certificate repair adds one.
+    pub rounds: u32,
+    /// Pairs added to the candidate graph by the certificate.
+    pub added_pairs: usize,
+    /// Exit edges added because the candidate graph had no perfect matching.
+    pub growth_pairs: usize,
+    /// Edges of the final candidate graph (`n²` for the dense oracle).
+    pub edges: usize,
+    /// Points returned by the certificate's radius queries, all passes together.
+    pub certificate_examined: u64,
+    /// Wall-clock time of the call, in seconds.
+    pub seconds: f64,
+}
+
+impl Pairing {
+    /// Mean pair distance, in particle diameters.
+    #[must_use]
+    pub fn mean_distance_in_diameters(&self, diameter: f64) -> f64 {
+        self.total_distance / self.g.len() as f64 / diameter
+    }
+}
+
+/// Why a pairing could not be computed. Bad input is reported, never a panic.
+#[derive(Debug, thiserror::Error)]
+pub enum PairingError {
+    /// The snapshots hold different numbers of particles.
+    #[error("the snapshots differ in size: {n0} particles at t0, {n1} at t1")]
+    LengthMismatch { n0: usize, n1: usize },
+    /// Nothing to pair.
+    #[error("the snapshots are empty: nothing to pair")]
+    Empty,
+    /// A coordinate is NaN or infinite.
+    #[error("non-finite coordinate in the {snapshot} snapshot: particle {index}, axis {axis} is {value}")]
+    NonFinite {
+        snapshot: &'static str,
+        index: usize,
+        axis: usize,
+        value: f64,
+    },
+    /// An option is out of range.
+    #[error("invalid pairing option `{name}`: {reason}")]
+    InvalidOption { name: &'static str, reason: String },
+    /// More particles than u32 indices can address.
+    #[error("{n} particles: at most {max} can be paired")]
+    TooMany { n: usize, max: usize },
+    /// `unit` is too small for the extent of the bed: costs would overflow.
+    #[error(
+        "the bed spans {extent} but the cost unit is {unit}: {units:.3e} units per pair, \
+         more than the {max_units:.3e} the solver can hold; use a larger unit"
+    )]
+    CostOverflow {
+        extent: f64,
+        unit: f64,
+        units: f64,
+        max_units: f64,
+    },
+    /// The dense oracle was asked for more than [`DENSE_LIMIT`] particles.
+    #[error("the dense oracle takes at most {max} particles, got {n}; use `pair`")]
+    TooLargeForDense { n: usize, max: usize },
+}
+
+/// Checks sizes and coordinates; returns n.
+fn validate(x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Result<usize, PairingError> {
+    if x0.len() != x1.len() {
+        return Err(PairingError::LengthMismatch {
+            n0: x0.len(),
+            n1: x1.len(),
+        });
+    }
+    if x0.is_empty() {
+        return Err(PairingError::Empty);
+    }
+    if x0.len() > u32::MAX as usize {
+        return Err(PairingError::TooMany {
+            n: x0.len(),
+            max: u32::MAX as usize,
+        });
+    }
+    for (snapshot, xs) in [("t0", x0), ("t1", x1)] {
+        for (index, p) in xs.iter().enumerate() {
+            if let Some(axis) = p.iter().position(|c| !c.is_finite()) {
+                return Err(PairingError::NonFinite {
+                    snapshot,
+                    index,
+                    axis,
+                    value: p[axis],
+                });
+            }
+        }
+    }
+    Ok(x0.len())
+}
+
+fn total_distance(x0: &[[f64; 3]], x1: &[[f64; 3]], g: &[u32]) -> f64 {
+    g.iter()
+        .enumerate()
+        .map(|(p, &q)| cost::distance(&x1[p], &x0[q as usize]))
+        .sum()
+}
+
+/// The exact pairing by the dense oracle (Kuhn–Munkres on all n² integer costs).
+/// For tests and n ≤ [`DENSE_LIMIT`]; `unit` as in [`PairingOptions::unit`].
+///
+/// # Errors
+///
+/// [`PairingError`] for snapshots of different or zero length, non-finite
+/// coordinates, a `unit` that is not positive or too small for the bed's extent, or
+/// more than [`DENSE_LIMIT`] particles.
+pub fn pair_dense(x0: &[[f64; 3]], x1: &[[f64; 3]], unit: f64) -> Result<Pairing, PairingError> {
+    let start = Instant::now();
+    let n = validate(x0, x1)?;
+    if n > DENSE_LIMIT {
+        return Err(PairingError::TooLargeForDense {
+            n,
+            max: DENSE_LIMIT,
+        });
+    }
+    let scale = cost::CostScale::new(x0, x1, unit)?;
+    let (g, total_cost) = dense::solve(x0, x1, &scale);
+    Ok(Pairing {
+        total_distance: total_distance(x0, x1, &g),
+        g,
+        total_cost,
+        k_used: n,
+        certified: true,
+        rounds: 1,
+        added_pairs: 0,
+        growth_pairs: 0,
+        edges: n * n,
+        certificate_examined: 0,
+        seconds: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// The exact pairing: minimises `Σ_p round(|x1[p] − x0[g[p]]| / unit)` over all
+/// bijections. Uses the dense oracle when `n <= opts.dense_max`, otherwise the sparse
+/// solver (see the module documentation). The parallel parts run on the current rayon
+/// pool; the result does not depend on the number of threads.
+///
+/// # Errors
+///
+/// [`PairingError`] for snapshots of different or zero length (or more than
+/// `u32::MAX` particles), non-finite coordinates, and out-of-range options
+/// (`k_initial = 0`, `dense_max > DENSE_LIMIT`, a `unit` that is not positive or too
+/// small for the bed's extent). Valid input never panics.
+pub fn pair(
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    opts: &PairingOptions,
+) -> Result<Pairing, PairingError> {
+    let start = Instant::now();
+    let n = validate(x0, x1)?;
+    if opts.k_initial == 0 {
+        return Err(PairingError::InvalidOption {
+            name: "k_initial",
+            reason: "must be at least 1".into(),
+        });
+    }
+    if opts.dense_max > DENSE_LIMIT {
+        return Err(PairingError::InvalidOption {
+            name: "dense_max",
+            reason: format!("at most {DENSE_LIMIT}, got {}", opts.dense_max),
+        });
+    }
+    if n <= opts.dense_max {
+        return pair_dense(x0, x1, opts.unit);
+    }
+    let scale = cost::CostScale::new(x0, x1, opts.unit)?;
+    let mut s = sparse(x0, x1, opts, &scale);
+    s.seconds = start.elapsed().as_secs_f64();
+    Ok(s)
+}
+
+/// The sparse solver: renumber, build the kNN graph, solve (adding exit edges if it has
+/// no perfect matching), certify, repair, repeat.
+fn sparse(
+    x0_in: &[[f64; 3]],
+    x1_in: &[[f64; 3]],
+    opts: &PairingOptions,
+    scale: &cost::CostScale,
+) -> Pairing {
+    let n = x0_in.len();
+    // Work on a Morton-ordered copy (cache locality); map back at the end.
+    let (lo, hi) = order::bounds(x0_in, x1_in);
+    let perm0 = order::morton_order(x0_in, lo, hi);
+    let perm1 = order::morton_order(x1_in, lo, hi);
+    let x0: Vec<[f64; 3]> = perm0.iter().map(|&i| x0_in[i as usize]).collect();
+    let x1: Vec<[f64; 3]> = perm1.iter().map(|&i| x1_in[i as usize]).collect();
+    let (x0, x1) = (&x0[..], &x1[..]);
+    let tree = candidates::build_tree(x0);
+
+    let k0 = opts.k_initial.min(n);
+    let (kc, kw) = candidates::knn(&tree, x0, x1, k0, scale);
+    let mut extras: Vec<(u32, u32)> = Vec::new();
+    let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+
+    // Optimal on the candidate graph, then the certificate; repair until it holds.
+    // If a search finds no augmenting path, the graph has no perfect matching: add exit
+    // edges on Hall-violating sets until Hopcroft–Karp finds a perfect matching, and
+    // carry on from the same state.
+    let mut lap = sparse_lap::Lap::new(n);
+    lap.greedy_init(&graph);
+    let mut wtree: Option<certificate::WeightedTree> = None;
+    let mut rounds = 0u32;
+    let mut added = 0usize;
+    let mut grown = 0usize;
+    let mut examined = 0u64;
+    let certified = loop {
+        rounds += 1;
+        while let Err(failed) = lap.solve(&graph) {
+            let before = grown;
+            let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
+            loop {
+                let deficient = m.deficient_rows(&graph);
+                if deficient.is_empty() {
+                    break;
+                }
+                let more = feasibility::exit_edges(&graph, x0, x1, &deficient);
+                grown += more.len();
+                extras = merge(extras, more);
+                graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+            }
+            // A failed search proves there is no perfect matching (the symmetric
+            // difference with one would hold an augmenting path), so growth happened.
+            assert!(
+                grown > before,
+                "internal error: search from row {} failed on a feasible graph",
+                failed.row
+            );
+            lap.restore_invariant(&graph);
+        }
+        if !opts.certify {
+            break false;
+        }
+        let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
+        let check = certificate::check(wtree, x1, &lap, scale);
+        examined += check.examined;
+        if check.violations.is_empty() {
+            break true;
+        }
+        // Every violation is a new edge (candidate edges cannot violate), so the graph
+        // grows strictly each round and the loop ends, at worst with all n² pairs.
+        added += check.violations.len();
+        extras = merge(extras, check.violations);
+        graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+        lap.restore_invariant(&graph);
+    };
+
+    // Back to the caller's numbering.
+    let mut g = vec![0u32; n];
+    for (p, &q) in lap.col_of_row.iter().enumerate() {
+        g[perm1[p] as usize] = perm0[q as usize];
+    }
+    Pairing {
+        total_cost: lap.mcost.iter().sum(),
+        total_distance: total_distance(x0_in, x1_in, &g),
+        g,
+        k_used: k0,
+        certified,
+        rounds,
+        added_pairs: added,
+        growth_pairs: grown,
+        edges: graph.edges(),
+        certificate_examined: examined,
+        seconds: 0.0,
+    }
+}
+
+/// Union of two sorted edge lists.
+fn merge(mut a: Vec<(u32, u32)>, b: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+    a.extend(b);
+    a.sort_unstable();
+    a.dedup();
+    a
+}

@@ -1,0 +1,49 @@
+//! Replay of a recorded collision table through the pairing (DESIGN.md §6, Haydar
+//! Algorithm 3): temperatures live per role, move to their new roles at each period
+//! boundary, and every row exchanges heat between its two bodies.
+
+mod schemes;
+mod table;
+
+pub use schemes::{apply_rows, apply_rows_with, Scheme, SyncScratch};
+pub use table::{Bodies, Exchange, Table};
+
+/// Why a table cannot be replayed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    #[error(
+        "the explicit scheme is unstable on this table: row {row} (bodies {i} and {j}, m = {duration_steps} steps, sqrt(a) = {sqrt_area:.4e} m) has CFL number c = H m (1/C_k + 1/C_l) = {cfl:.4} ≥ 1; \
+         record with a smaller --dtc-max (c scales with m) or replay with --scheme exact (unconditionally stable)"
+    )]
+    Cfl {
+        row: u64,
+        i: u32,
+        j: u32,
+        duration_steps: u32,
+        sqrt_area: f64,
+        cfl: f64,
+    },
+    #[error("pairing of {got} roles for {expected} particles")]
+    Roles { got: usize, expected: usize },
+}
+
+/// Moves temperatures to their roles for the next period: `next[g[a]] = temps[a]`.
+pub fn move_to_roles(temps: &[f64], g: &[u32], next: &mut Vec<f64>) -> Result<(), ReplayError> {
+    if g.len() != temps.len() {
+        return Err(ReplayError::Roles {
+            got: g.len(),
+            expected: temps.len(),
+        });
+    }
+    next.clear();
+    next.resize(temps.len(), 0.0);
+    for (a, &t) in temps.iter().enumerate() {
+        next[g[a] as usize] = t;
+    }
+    Ok(())
+}
+
+/// `Σ C T` over the particles (J).
+pub fn total_heat(temps: &[f64], bodies: &Bodies) -> f64 {
+    temps.iter().zip(&bodies.capacity).map(|(t, c)| t * c).sum()
+}

@@ -1,0 +1,111 @@
+//! The table in the replay's compact form: each row as its two bodies, its start and the
+//! heat it can carry per kelvin, `H·m` (J/K); 24 bytes a row.
+
+use recorder::format::{FormatError, RecordingInfo, RecordingReader, Snapshot};
+use recorder::record::CollisionRow;
+
+/// One row ready to apply.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Exchange {
+    /// Particle (role) id.
+    pub i: u32,
+    /// Other particle id, or `particles + wall` for a wall row.
+    pub j: u32,
+    pub start_step: u32,
+    /// `H · m`: conductance times the row's duration (J/K).
+    pub conductance_time: f64,
+}
+
+/// Heat capacities of the particles and temperatures of the conducting walls.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Bodies {
+    /// `C = ρ c (4/3)π r³` of each particle (J/K).
+    pub capacity: Vec<f64>,
+    pub inverse_capacity: Vec<f64>,
+    /// Fixed temperature of wall `w` (body `particles + w`), `None` if adiabatic.
+    pub wall_temperature: Vec<Option<f64>>,
+}
+
+impl Bodies {
+    /// The bodies of a recording, with the particle radii of its `t0` snapshot.
+    pub fn of(info: &RecordingInfo, t0: &Snapshot) -> Self {
+        let capacity: Vec<f64> = t0
+            .radius
+            .iter()
+            .map(|r| {
+                info.density * info.heat_capacity * (4.0 / 3.0) * std::f64::consts::PI * r * r * r
+            })
+            .collect();
+        Self {
+            inverse_capacity: capacity.iter().map(|c| 1.0 / c).collect(),
+            capacity,
+            wall_temperature: info.walls.iter().map(|w| w.temperature).collect(),
+        }
+    }
+
+    pub fn particles(&self) -> usize {
+        self.capacity.len()
+    }
+
+    /// The row's CFL number `c = H m (1/C_k + 1/C_l)` (a wall's capacity is infinite).
+    pub fn cfl(&self, e: &Exchange) -> f64 {
+        let inverse_l = self
+            .inverse_capacity
+            .get(e.j as usize)
+            .copied()
+            .unwrap_or(0.0);
+        e.conductance_time * (self.inverse_capacity[e.i as usize] + inverse_l)
+    }
+}
+
+impl Exchange {
+    /// A decoded row, with the recording's conduction constants.
+    pub fn of(row: &CollisionRow, info: &RecordingInfo) -> Self {
+        let conductivity = if row.j >= info.particles {
+            info.wall_conductivity
+        } else {
+            info.pair_conductivity
+        };
+        Self {
+            i: row.i,
+            j: row.j,
+            start_step: row.start_step as u32,
+            conductance_time: conductivity * row.sqrt_area * row.duration_steps as f64 * info.dt,
+        }
+    }
+}
+
+/// The whole table decoded once and kept in memory (the replay reads it every period).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Table {
+    pub exchanges: Vec<Exchange>,
+    /// For each exchange, `(duration_steps, sqrt(a))` — kept only to explain a CFL refusal.
+    pub source: Vec<(u32, f64)>,
+}
+
+impl Table {
+    /// Decodes the table of a recording (streamed batch by batch from the file).
+    pub fn read(reader: &RecordingReader) -> Result<Self, FormatError> {
+        let info = reader.info();
+        let mut table = Table::default();
+        for batch in reader.table() {
+            for row in &batch?.rows {
+                table.exchanges.push(Exchange::of(row, info));
+                table.source.push((row.duration_steps, row.sqrt_area));
+            }
+        }
+        Ok(table)
+    }
+
+    /// The row with the largest CFL number, as `(row, c)`.
+    pub fn max_cfl(&self, bodies: &Bodies) -> Option<(usize, f64)> {
+        self.exchanges
+            .iter()
+            .map(|e| bodies.cfl(e))
+            .enumerate()
+            .fold(None, |best, (k, c)| match best {
+                Some((_, b)) if b >= c => best,
+                _ => Some((k, c)),
+            })
+    }
+}

@@ -1,0 +1,129 @@
+//! `tdex pair`: the pairing of a recording's `t0` and `t1` snapshots, stored beside it for
+//! reuse by `tdex extrapolate` (`RECORDING.pairing.json`).
+
+use crate::cli::PairPlan;
+use anyhow::{Context, Result};
+use extrapolate::pairing::{self, PairingOptions};
+use recorder::format::{RecordingReader, Snapshot};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+
+/// The pairing summary (`tdex pair --json`; keys in docs/user-guide.md).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PairingSummary {
+    pub particles: usize,
+    pub diameter: f64,
+    pub total_distance_diameters: f64,
+    pub mean_distance_diameters: f64,
+    pub k_used: usize,
+    pub certified: bool,
+    pub rounds: u32,
+    pub seconds: f64,
+    pub threads: usize,
+}
+
+/// The stored pairing: `g[p]` = the role particle `p` takes in the next period.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct StoredPairing {
+    /// Size of the recording it belongs to (a different file is not reused).
+    pub recording_bytes: u64,
+    pub summary: PairingSummary,
+    pub g: Vec<u32>,
+}
+
+pub fn sidecar(recording: &Path) -> PathBuf {
+    let mut name = recording.as_os_str().to_owned();
+    name.push(".pairing.json");
+    PathBuf::from(name)
+}
+
+/// Mean diameter of a snapshot's particles.
+fn diameter(snap: &Snapshot) -> f64 {
+    2.0 * snap.radius.iter().sum::<f64>() / snap.len().max(1) as f64
+}
+
+/// Computes the pairing of the recording's snapshots 0 and 1.
+pub fn compute(reader: &RecordingReader) -> Result<StoredPairing> {
+    let t0 = reader
+        .snapshot(0)?
+        .context("the recording has no t0 snapshot")?;
+    let t1 = reader
+        .snapshot(1)?
+        .context("the recording has no t1 snapshot")?;
+    let d = diameter(&t0);
+    let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
+    Ok(StoredPairing {
+        recording_bytes: reader.file_bytes(),
+        summary: PairingSummary {
+            particles: p.g.len(),
+            diameter: d,
+            total_distance_diameters: p.total_distance / d,
+            mean_distance_diameters: p.mean_distance_in_diameters(d),
+            k_used: p.k_used,
+            certified: p.certified,
+            rounds: p.rounds,
+            seconds: p.seconds,
+            threads: rayon::current_num_threads(),
+        },
+        g: p.g,
+    })
+}
+
+/// The stored pairing of this recording, if there is one that matches it.
+pub fn load(reader: &RecordingReader) -> Option<StoredPairing> {
+    let text = std::fs::read_to_string(sidecar(reader.path())).ok()?;
+    let stored: StoredPairing = serde_json::from_str(&text).ok()?;
+    let n = reader.info().particles as usize;
+    let permutation = {
+        let mut seen = vec![false; n];
+        stored.g.len() == n
+            && stored
+                .g
+                .iter()
+                .all(|&r| (r as usize) < n && !std::mem::replace(&mut seen[r as usize], true))
+    };
+    (stored.recording_bytes == reader.file_bytes() && permutation).then_some(stored)
+}
+
+/// Writes the pairing beside the recording (temporary file, then rename).
+pub fn store(reader: &RecordingReader, stored: &StoredPairing) -> Result<PathBuf> {
+    let path = sidecar(reader.path());
+    let partial = path.with_extension("json.partial");
+    std::fs::write(&partial, serde_json::to_vec(stored)?)
+        .and_then(|_| std::fs::rename(&partial, &path))
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}
+
+pub fn run(plan: &PairPlan) -> Result<()> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(plan.threads)
+        .build()
+        .context("cannot start the worker threads")?;
+    let reader = RecordingReader::open(&plan.file)?;
+    let stored = pool.install(|| compute(&reader))?;
+    let path = store(&reader, &stored)?;
+    let s = &stored.summary;
+    if plan.json {
+        let mut json = serde_json::to_value(s)?;
+        json["pairing_file"] = path.display().to_string().into();
+        println!("{}", serde_json::to_string_pretty(&json)?);
+    } else {
+        println!(
+            "pairing       {} particles, total distance {:.2} diameters (mean {:.4}), k = {}, {} rounds, {}",
+            s.particles,
+            s.total_distance_diameters,
+            s.mean_distance_diameters,
+            s.k_used,
+            s.rounds,
+            if s.certified { "certified optimal" } else { "NOT certified" }
+        );
+        println!(
+            "time          {:.3} s on {} threads; stored in {}",
+            s.seconds,
+            s.threads,
+            path.display()
+        );
+    }
+    Ok(())
+}
