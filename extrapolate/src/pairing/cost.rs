@@ -40,14 +40,7 @@ impl CostScale {
                 reason: format!("must be finite and > 0, got {unit}"),
             });
         }
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
-        for p in x0.iter().chain(x1) {
-            for a in 0..3 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
+        let (lo, hi) = super::order::bounds(x0, x1);
         // The diagonal bounds every pair distance; computed per axis first so that a
         // huge extent shows up as infinity rather than silently wrapping.
         let diag = distance(&lo, &hi);
