@@ -1,7 +1,7 @@
 //! `tdex bench`: measured figures for docs/benchmarks.md, each against its peer in the same run.
 
 use crate::cli::BenchRecordPlan;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use recorder::format::RecordingReader;
 use recorder::record::{self, Phase};
 use serde::Serialize;
@@ -37,11 +37,7 @@ struct RecordBench {
 /// Runs the case to `t0` once; then, from copies of that state, the period plain and recorded
 /// (alternating, `repeats` times each).
 pub fn record(plan: &BenchRecordPlan) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("cannot start the worker threads")?;
-    pool.install(|| bench_record(plan))
+    crate::with_workers(plan.threads, || bench_record(plan))
 }
 
 fn bench_record(plan: &BenchRecordPlan) -> Result<()> {

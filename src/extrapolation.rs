@@ -3,10 +3,9 @@
 use crate::cli::ExtrapolatePlan;
 use crate::pair;
 use anyhow::{Context, Result};
-use extrapolate::replay::{self, Bodies, Exchange, ReplayError, Scheme, SyncScratch, Table};
+use extrapolate::replay::{self, Bodies, Exchange, Scheme, SyncScratch, Table};
 use recorder::format::{
-    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingReader, Snapshot,
-    FORMAT_VERSION,
+    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingReader, FORMAT_VERSION,
 };
 use serde::Serialize;
 use std::time::Instant;
@@ -28,37 +27,20 @@ struct ExtrapolationReport {
 }
 
 pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("cannot start the worker threads")?;
-    pool.install(|| extrapolate(plan))
-}
-
-fn scheme_name(s: Scheme) -> &'static str {
-    match s {
-        Scheme::Explicit => "explicit",
-        Scheme::Exact => "exact",
-        Scheme::Synchronous => "synchronous",
-    }
+    crate::with_workers(plan.threads, || extrapolate(plan))
 }
 
 fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
     let reader = RecordingReader::open(&plan.file)?;
     let info = reader.info().clone();
-    let t0 = reader
-        .snapshot(0)?
-        .context("the recording has no t0 snapshot")?;
-    let t1 = reader
-        .snapshot(1)?
-        .context("the recording has no t1 snapshot")?;
+    let (t0, t1) = pair::period_snapshots(&reader)?;
     let bodies = Bodies::of(&info, &t0);
 
     let started = Instant::now();
     let (stored, reused) = match pair::load(&reader) {
         Some(stored) => (stored, true),
         None => {
-            let stored = pair::compute(&reader)?;
+            let stored = pair::compute(&reader, &t0, &t1)?;
             pair::store(&reader, &stored)?;
             (stored, false)
         }
@@ -71,36 +53,18 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
 
     // the table: decoded once into memory, or streamed from the file each period
     let t = Instant::now();
-    let table = if plan.stream {
-        None
+    let (table, rows, worst) = if plan.stream {
+        let found = replay::scan(&reader, &bodies, |_, _| {})?;
+        (None, found.rows, found.worst)
     } else {
-        Some(Table::read(&reader)?)
-    };
-    let (rows, worst) = match &table {
-        Some(table) => (
-            table.exchanges.len() as u64,
-            table.max_cfl(&bodies).map(|(k, c)| {
-                let (m, a) = table.source[k];
-                let e = table.exchanges[k];
-                (k as u64, e.i, e.j, m, a, c)
-            }),
-        ),
-        None => stream_max_cfl(&reader, &bodies)?,
+        let (table, worst) = Table::read(&reader, &bodies)?;
+        let rows = table.exchanges.len() as u64;
+        (Some(table), rows, worst)
     };
     let seconds_read_table = t.elapsed().as_secs_f64();
-    let max_cfl = worst.map_or(0.0, |w| w.5);
-    if plan.scheme == Scheme::Explicit {
-        if let Some((row, i, j, duration_steps, sqrt_area, cfl)) = worst.filter(|w| w.5 >= 1.0) {
-            return Err(ReplayError::Cfl {
-                row,
-                i,
-                j,
-                duration_steps,
-                sqrt_area,
-                cfl,
-            })
-            .with_context(|| format!("{}", plan.file.display()));
-        }
+    let max_cfl = worst.map_or(0.0, |w| w.cfl);
+    if let Some(w) = worst.filter(|w| plan.scheme == Scheme::Explicit && w.cfl >= 1.0) {
+        return Err(w.refusal()).with_context(|| format!("{}", plan.file.display()));
     }
 
     let out_info = ExtrapolationInfo {
@@ -108,7 +72,7 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
         tool_version: env!("CARGO_PKG_VERSION").into(),
         recording: plan.file.display().to_string(),
         recording_info: info.clone(),
-        scheme: scheme_name(plan.scheme).into(),
+        scheme: plan.scheme.name().into(),
         periods: plan.periods,
         pairing: serde_json::to_value(&stored.summary)?,
     };
@@ -120,6 +84,9 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
     let heat_t1 = replay::total_heat(&temps, &bodies);
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
+    let mut exchanges: Vec<Exchange> = Vec::new();
+    // the output snapshot: t1's positions, radii and velocities, the extrapolated temperatures
+    let mut out = t1;
     let t = Instant::now();
     for k in 1..=plan.periods {
         replay::move_to_roles(&temps, &stored.g, &mut next)?;
@@ -134,8 +101,8 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
             ),
             None => {
                 for batch in reader.table() {
-                    let exchanges: Vec<Exchange> =
-                        batch?.rows.iter().map(|r| Exchange::of(r, &info)).collect();
+                    exchanges.clear();
+                    exchanges.extend(batch?.rows.iter().map(|r| Exchange::of(r, &info)));
                     replay::apply_rows_with(
                         &mut temps,
                         &exchanges,
@@ -146,12 +113,11 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
                 }
             }
         }
-        writer.write_snapshot(&Snapshot {
-            index: k + 1,
-            time: info.snapshot_time(k + 1),
-            temp: temps.clone(),
-            ..t1.clone()
-        })?;
+        scratch.flush(&mut temps);
+        out.index = k + 1;
+        out.time = info.snapshot_time(k + 1);
+        out.temp.copy_from_slice(&temps);
+        writer.write_snapshot(&out)?;
     }
     let seconds_replay = t.elapsed().as_secs_f64();
     let costs = ExtrapolationCosts {
@@ -166,7 +132,7 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
     writer.finish(&costs)?;
     let report = ExtrapolationReport {
         output: plan.output.display().to_string(),
-        scheme: scheme_name(plan.scheme).into(),
+        scheme: plan.scheme.name().into(),
         periods: plan.periods,
         particles: info.particles,
         rows,
@@ -218,29 +184,4 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
         );
     }
     Ok(())
-}
-
-type Worst = Option<(u64, u32, u32, u32, f64, f64)>;
-
-/// Rows and the worst CFL row, reading the table once from the file.
-fn stream_max_cfl(reader: &RecordingReader, bodies: &Bodies) -> Result<(u64, Worst)> {
-    let (mut rows, mut worst): (u64, Worst) = (0, None);
-    for batch in reader.table() {
-        let batch = batch?;
-        for (k, r) in batch.rows.iter().enumerate() {
-            let c = bodies.cfl(&Exchange::of(r, reader.info()));
-            if worst.is_none_or(|w| c > w.5) {
-                worst = Some((
-                    batch.first_row + k as u64,
-                    r.i,
-                    r.j,
-                    r.duration_steps,
-                    r.sqrt_area,
-                    c,
-                ));
-            }
-        }
-        rows += batch.rows.len() as u64;
-    }
-    Ok((rows, worst))
 }

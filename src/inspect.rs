@@ -3,6 +3,7 @@
 
 use crate::cli::InspectPlan;
 use anyhow::Result;
+use extrapolate::replay::{self, Bodies, CflRow};
 use recorder::format::{RecordingCosts, RecordingReader};
 use serde::Serialize;
 
@@ -25,17 +26,6 @@ struct SnapshotSummary {
     time: f64,
     mean_temperature: f64,
     mean_position: [f64; 3],
-}
-
-#[derive(Debug, Serialize)]
-struct WorstRow {
-    row: u64,
-    i: u32,
-    j: u32,
-    start_step: u64,
-    duration_steps: u32,
-    sqrt_area: f64,
-    cfl: f64,
 }
 
 /// How a recording was sampled; shared by the `record` and `inspect` reports.
@@ -88,7 +78,7 @@ struct Inspection {
     collisions: u64,
     duration_histogram: Vec<HistogramBin>,
     suggested_n: Option<u64>,
-    max_cfl: Option<WorstRow>,
+    max_cfl: Option<CflRow>,
     snapshots: Vec<SnapshotSummary>,
     costs: Option<RecordingCosts>,
 }
@@ -103,48 +93,11 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
             detail: "no snapshot at t0 (index 0)".into(),
         }
     })?;
-    // heat capacity of every body, from the t0 radii; walls are isothermal (infinite C)
-    let capacity: Vec<f64> = t0
-        .radius
-        .iter()
-        .map(|r| info.density * info.heat_capacity * 4.0 / 3.0 * std::f64::consts::PI * r.powi(3))
-        .collect();
-    let (mut rows, mut wall_rows, mut batches, mut contact_steps) = (0u64, 0u64, 0u64, 0u64);
-    let mut worst: Option<WorstRow> = None;
-    for batch in reader.table() {
-        let batch = batch?;
-        batches += 1;
-        for (k, r) in batch.rows.iter().enumerate() {
-            let wall = r.j >= info.particles;
-            wall_rows += wall as u64;
-            contact_steps += r.duration_steps as u64;
-            let conductivity = if wall {
-                info.wall_conductivity
-            } else {
-                info.pair_conductivity
-            };
-            let h = conductivity * r.sqrt_area;
-            let inverse_c = 1.0 / capacity[r.i as usize]
-                + if wall {
-                    0.0
-                } else {
-                    1.0 / capacity[r.j as usize]
-                };
-            let cfl = h * r.duration_steps as f64 * info.dt * inverse_c;
-            if worst.as_ref().is_none_or(|w| cfl > w.cfl) {
-                worst = Some(WorstRow {
-                    row: batch.first_row + k as u64,
-                    i: r.i,
-                    j: r.j,
-                    start_step: r.start_step,
-                    duration_steps: r.duration_steps,
-                    sqrt_area: r.sqrt_area,
-                    cfl,
-                });
-            }
-        }
-        rows += batch.rows.len() as u64;
-    }
+    let (mut wall_rows, mut contact_steps) = (0u64, 0u64);
+    let found = replay::scan(&reader, &Bodies::of(&info, t0), |r, _| {
+        wall_rows += (r.j >= info.particles) as u64;
+        contact_steps += r.duration_steps as u64;
+    })?;
     let summary = reader.summary().cloned();
     let n = info.sample_every as u64;
     let histogram: Vec<HistogramBin> = summary.as_ref().map_or_else(Vec::new, |s| {
@@ -188,16 +141,16 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
             .filter(|w| w.temperature.is_some())
             .count(),
         area_encoding: format!("{:?}", info.area_encoding).to_lowercase(),
-        rows,
+        rows: found.rows,
         wall_rows,
-        batches,
+        batches: found.batches,
         contact_steps,
         table_bytes: reader.table_bytes(),
-        bytes_per_row: reader.table_bytes() as f64 / rows.max(1) as f64,
+        bytes_per_row: reader.table_bytes() as f64 / found.rows.max(1) as f64,
         collisions,
         duration_histogram: histogram,
         suggested_n,
-        max_cfl: worst,
+        max_cfl: found.worst,
         snapshots: snapshots
             .iter()
             .map(|s| {

@@ -11,6 +11,19 @@ mod run;
 
 use std::process::ExitCode;
 
+/// Runs `work` on a pool of `threads` workers (results never depend on the count).
+fn with_workers<R: Send>(
+    threads: usize,
+    work: impl FnOnce() -> anyhow::Result<R> + Send,
+) -> anyhow::Result<R> {
+    use anyhow::Context;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start the worker threads")?
+        .install(work)
+}
+
 fn main() -> ExitCode {
     let args = cli::Cli::parse_args();
     let result = cli::Plan::from_args(args).and_then(|plan| match plan {

@@ -42,15 +42,20 @@ fn diameter(snap: &Snapshot) -> f64 {
     2.0 * snap.radius.iter().sum::<f64>() / snap.len().max(1) as f64
 }
 
-/// Computes the pairing of the recording's snapshots 0 and 1.
-pub fn compute(reader: &RecordingReader) -> Result<StoredPairing> {
+/// The snapshots at `t0` and `t1` that bound the recorded period.
+pub fn period_snapshots(reader: &RecordingReader) -> Result<(Snapshot, Snapshot)> {
     let t0 = reader
         .snapshot(0)?
         .context("the recording has no t0 snapshot")?;
     let t1 = reader
         .snapshot(1)?
         .context("the recording has no t1 snapshot")?;
-    let d = diameter(&t0);
+    Ok((t0, t1))
+}
+
+/// Computes the pairing of the recording's snapshots at `t0` and `t1`.
+pub fn compute(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing> {
+    let d = diameter(t0);
     let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
     Ok(StoredPairing {
         recording_bytes: reader.file_bytes(),
@@ -96,12 +101,9 @@ pub fn store(reader: &RecordingReader, stored: &StoredPairing) -> Result<PathBuf
 }
 
 pub fn run(plan: &PairPlan) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("cannot start the worker threads")?;
     let reader = RecordingReader::open(&plan.file)?;
-    let stored = pool.install(|| compute(&reader))?;
+    let (t0, t1) = period_snapshots(&reader)?;
+    let stored = crate::with_workers(plan.threads, || compute(&reader, &t0, &t1))?;
     let path = store(&reader, &stored)?;
     let s = &stored.summary;
     if plan.json {

@@ -30,10 +30,6 @@ struct RecordReport {
 }
 
 pub fn run(plan: &RecordPlan) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("cannot start the worker threads")?;
     let bar = if plan.json {
         ProgressBar::hidden()
     } else {
@@ -59,15 +55,15 @@ pub fn run(plan: &RecordPlan) -> Result<()> {
         }
         bar.set_position(done);
     };
-    pool.install(|| {
-        record::record(
+    crate::with_workers(plan.threads, || {
+        Ok(record::record(
             &plan.case,
             &plan.case_path,
             &plan.case_toml,
             &plan.options,
             &plan.output,
             &mut progress,
-        )
+        )?)
     })
     .with_context(|| format!("recording case {}", plan.case_path.display()))?;
     bar.finish_and_clear();

@@ -52,11 +52,7 @@ fn progress_bar(total: u64, json: bool) -> ProgressBar {
 }
 
 pub fn run(plan: &RunPlan) -> Result<()> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(plan.threads)
-        .build()
-        .context("cannot start the worker threads")?;
-    let summary = pool.install(|| simulate(plan))?;
+    let summary = crate::with_workers(plan.threads, || simulate(plan))?;
     if plan.json {
         println!("{}", serde_json::to_string_pretty(&summary)?);
     } else {

@@ -6,7 +6,7 @@ use crate::cli_run::TINY_CASE;
 use crate::util::*;
 use extrapolate::pairing::{pair, PairingOptions};
 use extrapolate::replay::{self, Bodies, Scheme, Table};
-use recorder::format::RecordingReader;
+use recorder::format::{RecordingReader, Snapshot};
 use std::path::Path;
 
 fn record(dir: &Path, case_text: &str, flags: &[&str]) -> std::path::PathBuf {
@@ -25,6 +25,25 @@ fn record(dir: &Path, case_text: &str, flags: &[&str]) -> std::path::PathBuf {
     out
 }
 
+/// The snapshots at `t0` and `t1`, the bodies and the in-memory table of a recording.
+fn open(recording: &Path) -> (Snapshot, Snapshot, Bodies, Table) {
+    let reader = RecordingReader::open(recording).unwrap();
+    let (t0, t1) = (
+        reader.snapshot(0).unwrap().unwrap(),
+        reader.snapshot(1).unwrap().unwrap(),
+    );
+    let bodies = Bodies::of(reader.info(), &t0);
+    let (table, _) = Table::read(&reader, &bodies).unwrap();
+    (t0, t1, bodies, table)
+}
+
+fn max_difference(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
 #[test]
 fn replaying_the_recorded_period_reproduces_the_dem_temperatures_at_t1() {
     let dir = tempfile::tempdir().unwrap();
@@ -41,26 +60,11 @@ fn replaying_the_recorded_period_reproduces_the_dem_temperatures_at_t1() {
             "--exact-area",
         ],
     );
-    let reader = RecordingReader::open(&out).unwrap();
-    let (t0, t1) = (
-        reader.snapshot(0).unwrap().unwrap(),
-        reader.snapshot(1).unwrap().unwrap(),
-    );
-    let bodies = Bodies::of(reader.info(), &t0);
-    let table = Table::read(&reader).unwrap();
+    let (t0, t1, bodies, table) = open(&out);
     let mut temps = t0.temp.clone();
     replay::apply_rows(&mut temps, &table.exchanges, &bodies, Scheme::Synchronous);
-    let worst = temps
-        .iter()
-        .zip(&t1.temp)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let moved = t0
-        .temp
-        .iter()
-        .zip(&t1.temp)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
+    let worst = max_difference(&temps, &t1.temp);
+    let moved = max_difference(&t0.temp, &t1.temp);
     eprintln!(
         "{} rows; largest DEM change over the period {moved:.3e} K, replay error {worst:.3e} K",
         table.exchanges.len()
@@ -73,13 +77,7 @@ fn replaying_the_recorded_period_reproduces_the_dem_temperatures_at_t1() {
 fn every_scheme_conserves_heat_over_100_periods() {
     let dir = tempfile::tempdir().unwrap();
     let out = record(dir.path(), TINY_CASE, &["--tau", "0.1"]);
-    let reader = RecordingReader::open(&out).unwrap();
-    let (t0, t1) = (
-        reader.snapshot(0).unwrap().unwrap(),
-        reader.snapshot(1).unwrap().unwrap(),
-    );
-    let bodies = Bodies::of(reader.info(), &t0);
-    let table = Table::read(&reader).unwrap();
+    let (t0, t1, bodies, table) = open(&out);
     let g = pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(0.01))
         .unwrap()
         .g;

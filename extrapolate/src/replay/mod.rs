@@ -6,7 +6,7 @@ mod schemes;
 mod table;
 
 pub use schemes::{apply_rows, apply_rows_with, Scheme, SyncScratch};
-pub use table::{Bodies, Exchange, Table};
+pub use table::{scan, Bodies, CflRow, Exchange, Table, TableScan};
 
 /// Why a table cannot be replayed.
 #[derive(Debug, thiserror::Error)]
@@ -25,6 +25,20 @@ pub enum ReplayError {
     },
     #[error("pairing of {got} roles for {expected} particles")]
     Roles { got: usize, expected: usize },
+}
+
+impl CflRow {
+    /// The explicit scheme's refusal of a table whose worst row is this one.
+    pub fn refusal(&self) -> ReplayError {
+        ReplayError::Cfl {
+            row: self.row,
+            i: self.i,
+            j: self.j,
+            duration_steps: self.duration_steps,
+            sqrt_area: self.sqrt_area,
+            cfl: self.cfl,
+        }
+    }
 }
 
 /// Moves temperatures to their roles for the next period: `next[g[a]] = temps[a]`.

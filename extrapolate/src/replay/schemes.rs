@@ -16,36 +16,61 @@ pub enum Scheme {
     Synchronous,
 }
 
-impl std::str::FromStr for Scheme {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "explicit" => Ok(Scheme::Explicit),
-            "exact" => Ok(Scheme::Exact),
-            "synchronous" => Ok(Scheme::Synchronous),
-            other => Err(format!(
-                "unknown scheme '{other}': use explicit, exact or synchronous"
-            )),
+impl Scheme {
+    pub const ALL: [Scheme; 3] = [Scheme::Explicit, Scheme::Exact, Scheme::Synchronous];
+
+    /// The scheme's name on the command line and in the files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::Explicit => "explicit",
+            Scheme::Exact => "exact",
+            Scheme::Synchronous => "synchronous",
         }
     }
 }
 
-/// Scratch space of the synchronous scheme (kept between calls to avoid reallocating).
+impl std::str::FromStr for Scheme {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Scheme::ALL
+            .into_iter()
+            .find(|scheme| scheme.name() == s)
+            .ok_or_else(|| format!("unknown scheme '{s}': use explicit, exact or synchronous"))
+    }
+}
+
+/// The synchronous scheme's group in progress: the deltas of the rows that started at
+/// `group_start`, applied when a row with another start arrives or at [`Self::flush`].
 #[derive(Debug, Default, Clone)]
 pub struct SyncScratch {
     delta: Vec<f64>,
     touched: Vec<u32>,
+    group_start: Option<u32>,
 }
 
-/// Applies `rows` (in apparition order) to the role temperatures `temps`.
+impl SyncScratch {
+    /// Applies the pending group; call it at the end of every period.
+    pub fn flush(&mut self, temps: &mut [f64]) {
+        for &b in &self.touched {
+            let b = b as usize;
+            temps[b] += self.delta[b];
+            self.delta[b] = 0.0;
+        }
+        self.touched.clear();
+        self.group_start = None;
+    }
+}
+
+/// Applies a whole period's `rows` (in apparition order) to the role temperatures `temps`.
 pub fn apply_rows(temps: &mut [f64], rows: &[Exchange], bodies: &Bodies, scheme: Scheme) {
     let mut scratch = SyncScratch::default();
     apply_rows_with(temps, rows, bodies, scheme, &mut scratch);
+    scratch.flush(temps);
 }
 
-/// [`apply_rows`] with caller-owned scratch (streaming replays call it batch after batch;
-/// a synchronous group split across two batches is completed by the next call, since the
-/// pending deltas stay in `scratch` until the start step changes).
+/// Applies consecutive rows of a period with caller-owned scratch: a streaming replay calls
+/// it batch after batch, and a synchronous group split between two batches stays pending in
+/// `scratch` until its start step changes. End the period with [`SyncScratch::flush`].
 pub fn apply_rows_with(
     temps: &mut [f64],
     rows: &[Exchange],
@@ -88,11 +113,10 @@ pub fn apply_rows_with(
             if scratch.delta.len() != temps.len() {
                 scratch.delta = vec![0.0; temps.len()];
             }
-            let mut group_start = None;
             for e in rows {
-                if group_start != Some(e.start_step) {
-                    flush(temps, scratch);
-                    group_start = Some(e.start_step);
+                if scratch.group_start != Some(e.start_step) {
+                    scratch.flush(temps);
+                    scratch.group_start = Some(e.start_step);
                 }
                 let (k, l) = (e.i as usize, e.j as usize);
                 let q = if e.j < n {
@@ -109,17 +133,6 @@ pub fn apply_rows_with(
                     scratch.touched.push(e.j);
                 }
             }
-            flush(temps, scratch);
         }
     }
-}
-
-/// Applies the pending synchronous deltas.
-fn flush(temps: &mut [f64], scratch: &mut SyncScratch) {
-    for &b in &scratch.touched {
-        let b = b as usize;
-        temps[b] += scratch.delta[b];
-        scratch.delta[b] = 0.0;
-    }
-    scratch.touched.clear();
 }

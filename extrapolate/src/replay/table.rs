@@ -75,37 +75,76 @@ impl Exchange {
     }
 }
 
+/// The row with the largest CFL number `c = H m (1/C_k + 1/C_l)`, as a user needs it to
+/// change the recording (its ids, duration and area).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct CflRow {
+    pub row: u64,
+    pub i: u32,
+    pub j: u32,
+    pub start_step: u64,
+    pub duration_steps: u32,
+    pub sqrt_area: f64,
+    pub cfl: f64,
+}
+
+/// What one pass over a table found.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct TableScan {
+    pub rows: u64,
+    pub batches: u64,
+    /// The row with the largest CFL number.
+    pub worst: Option<CflRow>,
+}
+
+/// One pass over the table in the file: hands every row, decoded and as an [`Exchange`],
+/// to `each`, and finds the worst CFL row. Memory: one chunk and one batch.
+pub fn scan(
+    reader: &RecordingReader,
+    bodies: &Bodies,
+    mut each: impl FnMut(&CollisionRow, Exchange),
+) -> Result<TableScan, FormatError> {
+    let info = reader.info();
+    let mut found = TableScan::default();
+    for batch in reader.table() {
+        let batch = batch?;
+        for (k, r) in batch.rows.iter().enumerate() {
+            let e = Exchange::of(r, info);
+            let cfl = bodies.cfl(&e);
+            if found.worst.is_none_or(|w| cfl > w.cfl) {
+                found.worst = Some(CflRow {
+                    row: batch.first_row + k as u64,
+                    i: r.i,
+                    j: r.j,
+                    start_step: r.start_step,
+                    duration_steps: r.duration_steps,
+                    sqrt_area: r.sqrt_area,
+                    cfl,
+                });
+            }
+            each(r, e);
+        }
+        found.rows += batch.rows.len() as u64;
+        found.batches += 1;
+    }
+    Ok(found)
+}
+
 /// The whole table decoded once and kept in memory (the replay reads it every period).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Table {
     pub exchanges: Vec<Exchange>,
-    /// For each exchange, `(duration_steps, sqrt(a))` — kept only to explain a CFL refusal.
-    pub source: Vec<(u32, f64)>,
 }
 
 impl Table {
-    /// Decodes the table of a recording (streamed batch by batch from the file).
-    pub fn read(reader: &RecordingReader) -> Result<Self, FormatError> {
-        let info = reader.info();
-        let mut table = Table::default();
-        for batch in reader.table() {
-            for row in &batch?.rows {
-                table.exchanges.push(Exchange::of(row, info));
-                table.source.push((row.duration_steps, row.sqrt_area));
-            }
-        }
-        Ok(table)
-    }
-
-    /// The row with the largest CFL number, as `(row, c)`.
-    pub fn max_cfl(&self, bodies: &Bodies) -> Option<(usize, f64)> {
-        self.exchanges
-            .iter()
-            .map(|e| bodies.cfl(e))
-            .enumerate()
-            .fold(None, |best, (k, c)| match best {
-                Some((_, b)) if b >= c => best,
-                _ => Some((k, c)),
-            })
+    /// Decodes the table of a recording (streamed batch by batch from the file), with its
+    /// worst CFL row.
+    pub fn read(
+        reader: &RecordingReader,
+        bodies: &Bodies,
+    ) -> Result<(Self, Option<CflRow>), FormatError> {
+        let mut exchanges = Vec::new();
+        let found = scan(reader, bodies, |_, e| exchanges.push(e))?;
+        Ok((Self { exchanges }, found.worst))
     }
 }
