@@ -2,7 +2,9 @@
 //! conventions (`foxglove.PointCloud` on `/tdex/snapshots`, sequence = snapshot index).
 
 use super::proto::POINT_CLOUD_DESCRIPTOR;
-use super::writer::{close_into_place, open_partial, write_json_metadata, McapWriter};
+use super::writer::{
+    close_into_place, log_time, open_partial, write_json_metadata, write_message, McapWriter,
+};
 use super::*;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -68,18 +70,14 @@ impl ExtrapolationWriter {
     }
 
     pub fn write_snapshot(&mut self, snapshot: &Snapshot) -> Result<(), FormatError> {
-        let time = (snapshot.time * 1e9).round() as u64;
-        let header = mcap::records::MessageHeader {
-            channel_id: self.channel,
-            sequence: snapshot.index,
-            log_time: time,
-            publish_time: time,
-        };
-        let result = self
-            .mcap
-            .as_mut()
-            .expect("not finished")
-            .write_to_known_channel(&header, &snapshot.encode());
+        let mcap = self.mcap.as_mut().expect("not finished");
+        let result = write_message(
+            mcap,
+            self.channel,
+            snapshot.index,
+            log_time(snapshot.time),
+            &snapshot.encode(),
+        );
         result.map_err(|error| FormatError::Mcap {
             path: self.dest.clone(),
             error,

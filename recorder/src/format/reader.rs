@@ -2,6 +2,7 @@
 //! gives the metadata and chunk indexes, and the table is decoded one chunk at a time.
 
 use super::table::{self, TableBatch};
+use super::writer::log_time;
 use super::*;
 use memmap2::Mmap;
 use std::fs::File;
@@ -180,11 +181,23 @@ impl RecordingReader {
 
     /// Chunks holding messages of `channel`, in file order.
     fn chunks_of(&self, channel: u16) -> impl Iterator<Item = &mcap::records::ChunkIndex> {
+        self.chunks_of_at(channel, None)
+    }
+
+    /// Chunks holding messages of `channel` (logged at `time`, ns, if given), in file order.
+    fn chunks_of_at(
+        &self,
+        channel: u16,
+        time: Option<u64>,
+    ) -> impl Iterator<Item = &mcap::records::ChunkIndex> {
         let mut chunks: Vec<_> = self
             .summary
             .chunk_indexes
             .iter()
             .filter(|ci| ci.message_index_offsets.contains_key(&channel))
+            .filter(|ci| {
+                time.is_none_or(|t| (ci.message_start_time..=ci.message_end_time).contains(&t))
+            })
             .collect();
         chunks.sort_by_key(|ci| ci.chunk_start_offset);
         chunks.into_iter()
@@ -197,7 +210,16 @@ impl RecordingReader {
         &self,
         channel: u16,
     ) -> impl Iterator<Item = Result<(u32, Vec<u8>), FormatError>> + '_ {
-        self.chunks_of(channel).flat_map(move |ci| {
+        self.messages_at(channel, None)
+    }
+
+    /// [`Self::messages`] of the chunks that hold messages logged at `time` (ns), if given.
+    fn messages_at(
+        &self,
+        channel: u16,
+        time: Option<u64>,
+    ) -> impl Iterator<Item = Result<(u32, Vec<u8>), FormatError>> + '_ {
+        self.chunks_of_at(channel, time).flat_map(move |ci| {
             let chunk_error = |e: mcap::McapError| {
                 self.corrupt(format!(
                     "chunk at byte offset {}: {e}",
@@ -232,7 +254,16 @@ impl RecordingReader {
         let mut snaps = Vec::new();
         for m in self.messages(self.snapshot_channel) {
             let (index, data) = m?;
-            let snap = Snapshot::decode(index, &data).map_err(|e| self.corrupt(e))?;
+            snaps.push(self.decode_snapshot(index, &data)?);
+        }
+        snaps.sort_by_key(|s| s.index);
+        Ok(snaps)
+    }
+
+    /// Decodes a stored snapshot and checks it holds every particle in id order.
+    fn decode_snapshot(&self, index: u32, data: &[u8]) -> Result<Snapshot, FormatError> {
+        {
+            let snap = Snapshot::decode(index, data).map_err(|e| self.corrupt(e))?;
             if snap.len() != self.info.particles as usize {
                 return Err(self.corrupt(format!(
                     "snapshot {index}: {} points for {} particles",
@@ -251,15 +282,20 @@ impl RecordingReader {
                     snap.id[k]
                 )));
             }
-            snaps.push(snap);
+            Ok(snap)
         }
-        snaps.sort_by_key(|s| s.index);
-        Ok(snaps)
     }
 
-    /// The snapshot with this index, if stored.
+    /// The snapshot with this index, if stored; only its own chunk is read and decoded.
     pub fn snapshot(&self, index: u32) -> Result<Option<Snapshot>, FormatError> {
-        Ok(self.snapshots()?.into_iter().find(|s| s.index == index))
+        let time = log_time(self.info.snapshot_time(index));
+        for m in self.messages_at(self.snapshot_channel, Some(time)) {
+            let (sequence, data) = m?;
+            if sequence == index {
+                return self.decode_snapshot(index, &data).map(Some);
+            }
+        }
+        Ok(None)
     }
 
     /// The table, batch by batch in apparition order; memory holds one chunk and one batch.

@@ -86,7 +86,7 @@ impl RecordingWriter {
     }
 
     fn nanos(&self, step: u64) -> u64 {
-        (step as f64 * self.info.dt * 1e9).round() as u64
+        log_time(step as f64 * self.info.dt)
     }
 
     /// Stores a snapshot in its own chunk (the table chunks then hold only table rows).
@@ -94,16 +94,10 @@ impl RecordingWriter {
         let step = self.info.step_t0 + snapshot.index as u64 * self.info.period_steps;
         let time = self.nanos(step);
         let data = snapshot.encode();
-        let header = mcap::records::MessageHeader {
-            channel_id: self.snapshot_channel,
-            sequence: snapshot.index,
-            log_time: time,
-            publish_time: time,
-        };
         let mcap = self.mcap.as_mut().expect("not finished");
         let result = mcap
             .flush()
-            .and_then(|_| mcap.write_to_known_channel(&header, &data))
+            .and_then(|_| write_message(mcap, self.snapshot_channel, snapshot.index, time, &data))
             .and_then(|_| mcap.flush());
         self.snapshots += 1;
         result.map_err(|e| self.mcap_err(e))
@@ -135,17 +129,14 @@ impl RecordingWriter {
             self.info.sqrt_area_unit,
         );
         let time = self.nanos(self.info.step_t0 + self.pending[0].start_step);
-        let header = mcap::records::MessageHeader {
-            channel_id: self.collision_channel,
-            sequence: self.batches as u32,
-            log_time: time,
-            publish_time: time,
-        };
-        let result = self
-            .mcap
-            .as_mut()
-            .expect("not finished")
-            .write_to_known_channel(&header, &data);
+        let mcap = self.mcap.as_mut().expect("not finished");
+        let result = write_message(
+            mcap,
+            self.collision_channel,
+            self.batches as u32,
+            time,
+            &data,
+        );
         result.map_err(|e| self.mcap_err(e))?;
         self.rows_written += self.pending.len() as u64;
         self.batches += 1;
@@ -211,6 +202,28 @@ pub(crate) fn open_partial(dest: &Path) -> Result<(McapWriter, PathBuf), FormatE
 }
 
 pub(crate) type McapWriter = mcap::Writer<BufWriter<File>>;
+
+/// MCAP log (and publish) time of a simulated instant: nanoseconds of simulated time.
+pub(crate) fn log_time(seconds: f64) -> u64 {
+    (seconds * 1e9).round() as u64
+}
+
+/// One message on a known channel, logged at `time` (ns).
+pub(crate) fn write_message(
+    mcap: &mut McapWriter,
+    channel: u16,
+    sequence: u32,
+    time: u64,
+    data: &[u8],
+) -> Result<(), mcap::McapError> {
+    let header = mcap::records::MessageHeader {
+        channel_id: channel,
+        sequence,
+        log_time: time,
+        publish_time: time,
+    };
+    mcap.write_to_known_channel(&header, data)
+}
 
 /// A metadata record holding `value` as JSON under the key `json`.
 pub(crate) fn write_json_metadata(
