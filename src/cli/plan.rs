@@ -115,8 +115,7 @@ impl Plan {
                 json,
             } => {
                 let threads = threads(t)?;
-                let loaded = recorder::case::load(&case)?;
-                let case_toml = std::fs::read_to_string(&case)?;
+                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
                 let options =
                     record_options(&loaded, tau, tau_rev, n, dtc_max, reference, exact_area)?;
                 check_output(&output)?;
@@ -184,8 +183,7 @@ impl Plan {
                         "--repeats = 0 is not allowed: give at least 1".into(),
                     ));
                 }
-                let loaded = recorder::case::load(&case)?;
-                let case_toml = std::fs::read_to_string(&case)?;
+                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
                 let options = record_options(&loaded, None, Some(tau_rev), n, dtc_max, 0, false)?;
                 Ok(Plan::BenchRecord(BenchRecordPlan {
                     case_path: case,

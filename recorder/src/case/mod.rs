@@ -30,11 +30,16 @@ pub enum CaseError {
 
 /// Reads, parses and validates a case file.
 pub fn load(path: &Path) -> Result<Case, CaseError> {
+    load_with_text(path).map(|(case, _)| case)
+}
+
+/// [`load`], also returning the file's text as given (a recording stores it).
+pub fn load_with_text(path: &Path) -> Result<(Case, String), CaseError> {
     let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    parse(&text, path)
+    Ok((parse(&text, path)?, text))
 }
 
 /// Parses and validates case text; `path` is only used in messages.
