@@ -85,12 +85,16 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
     let mut exchanges: Vec<Exchange> = Vec::new();
-    // the output snapshot: t1's positions, radii and velocities, the extrapolated temperatures
+    // the output snapshot: t1's positions, radii and velocities, the extrapolated
+    // temperatures, and as `id` the particle that plays each role (it moves with its heat)
     let mut out = t1;
+    let mut next_id = Vec::with_capacity(out.id.len());
     let t = Instant::now();
     for k in 1..=plan.periods {
         replay::move_to_roles(&temps, &stored.g, &mut next)?;
         std::mem::swap(&mut temps, &mut next);
+        replay::move_to_roles(&out.id, &stored.g, &mut next_id)?;
+        std::mem::swap(&mut out.id, &mut next_id);
         match &table {
             Some(table) => replay::apply_rows_with(
                 &mut temps,

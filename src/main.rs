@@ -3,10 +3,13 @@
 
 mod bench;
 mod cli;
+mod compare;
+mod demo;
 mod extrapolation;
 mod inspect;
 mod pair;
 mod record;
+mod report;
 mod run;
 
 use std::process::ExitCode;
@@ -33,6 +36,9 @@ fn main() -> ExitCode {
         cli::Plan::BenchRecord(p) => bench::record(&p),
         cli::Plan::Pair(p) => pair::run(&p),
         cli::Plan::Extrapolate(p) => extrapolation::run(&p),
+        cli::Plan::Compare(p) => compare::run(&p),
+        cli::Plan::Report(p) => report::run(&p),
+        cli::Plan::Demo(p) => demo::run(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -4,7 +4,9 @@
 mod util;
 
 mod cli_case_errors;
+mod cli_compare;
 mod cli_record;
+mod cli_report;
 mod cli_run;
 mod drum;
 mod physics_collision;

@@ -97,6 +97,53 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Compare an extrapolation with the recording's DEM reference at every t_k: Voronoi-cell
+    /// errors (eps_abs, eps_rel), the Eq. 10 energy-transfer error, hot/cold group means.
+    Compare {
+        /// The recording, made with --reference K.
+        recording: PathBuf,
+        /// The extrapolation of that recording.
+        extrapolation: PathBuf,
+        /// Voronoi cells (seeds drawn inside the bed).
+        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+        cells: usize,
+        /// Seed of the cell centres.
+        #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
+        seed: u64,
+        /// Print the comparison as one JSON object on stdout.
+        #[arg(long, conflicts_with = "csv")]
+        json: bool,
+        /// Print one CSV line per t_k on stdout.
+        #[arg(long)]
+        csv: bool,
+    },
+    /// Write a self-contained report (report.md, report.html, SVG plots) of an extrapolation
+    /// against its recording: the error table, the cost table for 100 periods, plots.
+    Report {
+        /// The recording, made with --reference K.
+        recording: PathBuf,
+        /// The extrapolation of that recording.
+        extrapolation: PathBuf,
+        /// The report directory (created if missing; files in it are replaced).
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Voronoi cells (seeds drawn inside the bed).
+        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+        cells: usize,
+        /// Seed of the cell centres.
+        #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
+        seed: u64,
+    },
+    /// The method end to end on the built-in small drum (2 000 particles): record one
+    /// revolution with a 6-period DEM reference, extrapolate 6 periods, compare, report.
+    Demo {
+        /// Directory for the case, the recording, the extrapolation and the report.
+        #[arg(short = 'o', long = "output", default_value = "tdex-demo")]
+        output: PathBuf,
+        /// Worker threads (default: all cores). Results do not depend on it.
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Benchmarks (figures for docs/benchmarks.md).
     #[command(subcommand)]
     Bench(BenchCommand),

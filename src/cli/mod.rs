@@ -4,6 +4,8 @@ mod args;
 mod plan;
 
 pub use args::Cli;
+pub(crate) use plan::record_options;
 pub use plan::{
-    BenchRecordPlan, ExtrapolatePlan, InspectPlan, PairPlan, Plan, RecordPlan, RunPlan, UsageError,
+    BenchRecordPlan, ComparePlan, DemoPlan, ExtrapolatePlan, InspectPlan, PairPlan, Plan,
+    RecordPlan, ReportPlan, RunPlan, UsageError,
 };

@@ -8,7 +8,8 @@ use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
 
-/// A flag value outside its allowed range.
+/// A flag value outside its allowed range, or input files the command cannot use together
+/// (exit code 2).
 #[derive(Debug)]
 pub struct UsageError(pub String);
 
@@ -27,6 +28,31 @@ pub enum Plan {
     BenchRecord(BenchRecordPlan),
     Pair(PairPlan),
     Extrapolate(ExtrapolatePlan),
+    Compare(ComparePlan),
+    Report(ReportPlan),
+    Demo(DemoPlan),
+}
+
+pub struct DemoPlan {
+    pub output: PathBuf,
+    pub threads: usize,
+}
+
+pub struct ReportPlan {
+    pub recording: PathBuf,
+    pub extrapolation: PathBuf,
+    pub output: PathBuf,
+    pub cells: usize,
+    pub seed: u64,
+}
+
+pub struct ComparePlan {
+    pub recording: PathBuf,
+    pub extrapolation: PathBuf,
+    pub cells: usize,
+    pub seed: u64,
+    pub json: bool,
+    pub csv: bool,
 }
 
 pub struct PairPlan {
@@ -168,6 +194,46 @@ impl Plan {
                     json,
                 }))
             }
+            Command::Compare {
+                recording,
+                extrapolation,
+                cells,
+                seed,
+                json,
+                csv,
+            } => {
+                check_cells(cells)?;
+                Ok(Plan::Compare(ComparePlan {
+                    recording,
+                    extrapolation,
+                    cells,
+                    seed,
+                    json,
+                    csv,
+                }))
+            }
+            Command::Report {
+                recording,
+                extrapolation,
+                output,
+                cells,
+                seed,
+            } => {
+                check_cells(cells)?;
+                check_output_dir(&output)?;
+                Ok(Plan::Report(ReportPlan {
+                    recording,
+                    extrapolation,
+                    output,
+                    cells,
+                    seed,
+                }))
+            }
+            Command::Demo { output, threads: t } => {
+                let threads = threads(t)?;
+                check_output_dir(&output)?;
+                Ok(Plan::Demo(DemoPlan { output, threads }))
+            }
             Command::Bench(BenchCommand::Record {
                 case,
                 tau_rev,
@@ -204,7 +270,7 @@ fn usage(message: String) -> anyhow::Error {
 }
 
 /// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.
-fn record_options(
+pub(crate) fn record_options(
     case: &Case,
     tau: Option<f64>,
     tau_rev: Option<f64>,
@@ -281,6 +347,37 @@ fn check_output(output: &std::path::Path) -> Result<()> {
         return Err(usage(format!(
             "-o {}: the directory {} does not exist",
             output.display(),
+            parent.display()
+        )));
+    }
+    Ok(())
+}
+
+fn check_cells(cells: usize) -> Result<()> {
+    if cells == 0 {
+        return Err(usage(
+            "--cells = 0 is not allowed: give at least 1 Voronoi cell".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// A report directory: an existing directory, or a new one whose parent exists.
+fn check_output_dir(dir: &std::path::Path) -> Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        return Err(usage(format!(
+            "-o {}: is a file; give a directory for the report",
+            dir.display()
+        )));
+    }
+    let parent = dir
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !parent.is_dir() {
+        return Err(usage(format!(
+            "-o {}: the directory {} does not exist",
+            dir.display(),
             parent.display()
         )));
     }

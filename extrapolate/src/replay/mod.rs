@@ -41,8 +41,13 @@ impl CflRow {
     }
 }
 
-/// Moves temperatures to their roles for the next period: `next[g[a]] = temps[a]`.
-pub fn move_to_roles(temps: &[f64], g: &[u32], next: &mut Vec<f64>) -> Result<(), ReplayError> {
+/// Moves what role `a` holds (a temperature, or the id of the particle playing it) to the
+/// role it plays in the next period: `next[g[a]] = temps[a]`.
+pub fn move_to_roles<T: Copy + Default>(
+    temps: &[T],
+    g: &[u32],
+    next: &mut Vec<T>,
+) -> Result<(), ReplayError> {
     if g.len() != temps.len() {
         return Err(ReplayError::Roles {
             got: g.len(),
@@ -50,7 +55,7 @@ pub fn move_to_roles(temps: &[f64], g: &[u32], next: &mut Vec<f64>) -> Result<()
         });
     }
     next.clear();
-    next.resize(temps.len(), 0.0);
+    next.resize(temps.len(), T::default());
     for (a, &t) in temps.iter().enumerate() {
         next[g[a] as usize] = t;
     }

@@ -1,6 +1,8 @@
 //! The extrapolation file: the extrapolated snapshots at every `t_k`, in the recording's
-//! conventions (`foxglove.PointCloud` on `/tdex/snapshots`, sequence = snapshot index).
+//! conventions (`foxglove.PointCloud` on `/tdex/snapshots`, sequence = snapshot index), its
+//! writer and its reader.
 
+use super::mcap_file::McapFile;
 use super::proto::POINT_CLOUD_DESCRIPTOR;
 use super::writer::{
     close_into_place, log_time, open_partial, write_json_metadata, write_message, McapWriter,
@@ -103,5 +105,95 @@ impl Drop for ExtrapolationWriter {
             drop(mcap);
             let _ = std::fs::remove_file(&self.partial);
         }
+    }
+}
+
+/// An open extrapolation file.
+pub struct ExtrapolationReader {
+    file: McapFile,
+    info: ExtrapolationInfo,
+    costs: Option<ExtrapolationCosts>,
+    snapshot_channel: u16,
+}
+
+impl std::fmt::Debug for ExtrapolationReader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ExtrapolationReader")
+            .field("path", &self.file.path)
+            .finish_non_exhaustive()
+    }
+}
+
+impl ExtrapolationReader {
+    /// Opens `path` and checks that it is a complete tdex extrapolation of a known version.
+    pub fn open(path: &Path) -> Result<Self, FormatError> {
+        let file = McapFile::open(path, "extrapolation")?;
+        let info: ExtrapolationInfo = file.metadata(EXTRAPOLATION_METADATA)?.ok_or_else(|| {
+            file.not_ours(format!(
+                "it has no '{EXTRAPOLATION_METADATA}' metadata record"
+            ))
+        })?;
+        if info.format_version != FORMAT_VERSION {
+            return Err(file.not_ours(format!(
+                "format version {} (this tdex reads version {FORMAT_VERSION})",
+                info.format_version
+            )));
+        }
+        let costs = file.metadata(EXTRAPOLATION_COSTS_METADATA)?;
+        let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;
+        Ok(Self {
+            file,
+            info,
+            costs,
+            snapshot_channel,
+        })
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.file.path
+    }
+
+    pub fn info(&self) -> &ExtrapolationInfo {
+        &self.info
+    }
+
+    /// What the extrapolation cost (absent only if the writer was interrupted).
+    pub fn costs(&self) -> Option<&ExtrapolationCosts> {
+        self.costs.as_ref()
+    }
+
+    /// All snapshots by index (1: the DEM state at `t1`, `k`: extrapolated `t_k`). Point
+    /// `j` is role `j` (at the position of particle `j` at `t1`); its `id` is the physical
+    /// particle playing the role at that instant, so `id` is a permutation of `0..N`.
+    pub fn snapshots(&self) -> Result<Vec<Snapshot>, FormatError> {
+        let n = self.info.recording_info.particles as usize;
+        let mut snaps = Vec::new();
+        for m in self.file.messages_at(self.snapshot_channel, None) {
+            let (index, data) = m?;
+            let snap = Snapshot::decode(index, &data).map_err(|e| self.file.corrupt(e))?;
+            if snap.len() != n {
+                return Err(self.file.corrupt(format!(
+                    "snapshot {index}: {} points for {n} particles",
+                    snap.len()
+                )));
+            }
+            let mut seen = vec![false; n];
+            for (j, &id) in snap.id.iter().enumerate() {
+                if id as usize >= n || std::mem::replace(&mut seen[id as usize], true) {
+                    return Err(self.file.corrupt(format!(
+                        "snapshot {index}: point {j} has id {id}, a repeat or out of 0..{n} \
+                         (ids must be a permutation)"
+                    )));
+                }
+            }
+            snaps.push(snap);
+        }
+        snaps.sort_by_key(|s| s.index);
+        if let Some(w) = snaps.windows(2).find(|w| w[0].index == w[1].index) {
+            return Err(self
+                .file
+                .corrupt(format!("snapshot {} stored twice", w[0].index)));
+        }
+        Ok(snaps)
     }
 }

@@ -2,13 +2,16 @@
 //! holds, the writer used by `tdex record` and the streaming reader used by `extrapolate`.
 
 pub mod extrapolation;
+mod mcap_file;
 pub mod proto;
 pub mod reader;
 pub mod snapshot;
 pub mod table;
 pub mod writer;
 
-pub use extrapolation::{ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter};
+pub use extrapolation::{
+    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationReader, ExtrapolationWriter,
+};
 pub use reader::RecordingReader;
 pub use snapshot::Snapshot;
 pub use table::TableBatch;
@@ -153,8 +156,13 @@ pub enum FormatError {
     NotMcap { path: PathBuf },
     #[error("{path}: the MCAP file is truncated or was not finished (no summary section / footer); record it again")]
     Truncated { path: PathBuf },
-    #[error("{path}: an MCAP file, but not a tdex recording: {detail}")]
-    NotRecording { path: PathBuf, detail: String },
+    #[error("{path}: an MCAP file, but not a tdex {expected}: {detail}")]
+    NotRecording {
+        path: PathBuf,
+        /// `recording` or `extrapolation`.
+        expected: &'static str,
+        detail: String,
+    },
     #[error("{path}: corrupted recording: {detail}")]
     Corrupt { path: PathBuf, detail: String },
     #[error("{path}: MCAP error: {error}")]

@@ -1,0 +1,151 @@
+//! The cost table in the form of the paper's Table 6: complete DEM against the extrapolated
+//! DEM for a number of periods, from the costs measured by `record` and `extrapolate`.
+
+use recorder::format::{ExtrapolationCosts, RecordingCosts};
+
+/// Periods of the paper's Table 6.
+pub const TABLE_PERIODS: u32 = 100;
+
+/// Where the DEM cost of one period was measured.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DemPeriodSource {
+    /// `seconds_reference / reference_periods`: the DEM run past `t1` without the recorder.
+    Reference { periods: u32 },
+    /// `seconds_period − seconds_recorder`: the recorded period without the recorder's share.
+    RecordedPeriod,
+}
+
+/// The measured costs, in wall-clock seconds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CostTable {
+    /// DEM to `t0` plus the recorded period without the recorder (both columns).
+    pub until_t1: f64,
+    /// Pairing of the `t0` and `t1` snapshots (extrapolated column only).
+    pub pairing: f64,
+    /// Whether the extrapolation reused a stored pairing (`pairing` is then its first cost).
+    pub pairing_reused: bool,
+    /// Recorder overhead of the recorded period: the collision file (extrapolated column only).
+    pub collision_file: f64,
+    /// DEM seconds per period and where they were measured.
+    pub tau_dem: f64,
+    pub tau_dem_source: DemPeriodSource,
+    /// Extrapolation seconds per period (replay).
+    pub tau_extra: f64,
+    /// Worker threads of the recording run.
+    pub threads: usize,
+}
+
+impl CostTable {
+    /// The table from a recording's and an extrapolation's costs. `pairing_seconds` is the
+    /// pairing summary's `seconds` (the cost of computing it, also when it was reused); when
+    /// absent the extrapolation's own `seconds_pairing` is used.
+    pub fn new(
+        recording: &RecordingCosts,
+        reference_periods: u32,
+        extrapolation: &ExtrapolationCosts,
+        pairing_seconds: Option<f64>,
+    ) -> Self {
+        let dem_period = recording.seconds_period - recording.seconds_recorder;
+        let (tau_dem, tau_dem_source) =
+            if reference_periods > 0 && recording.seconds_reference > 0.0 {
+                (
+                    recording.seconds_reference / reference_periods as f64,
+                    DemPeriodSource::Reference {
+                        periods: reference_periods,
+                    },
+                )
+            } else {
+                (dem_period, DemPeriodSource::RecordedPeriod)
+            };
+        CostTable {
+            until_t1: recording.seconds_to_t0 + dem_period,
+            pairing: pairing_seconds
+                .filter(|s| s.is_finite() && *s >= 0.0)
+                .unwrap_or(extrapolation.seconds_pairing),
+            pairing_reused: extrapolation.pairing_reused,
+            collision_file: recording.seconds_recorder,
+            tau_dem,
+            tau_dem_source,
+            tau_extra: extrapolation.seconds_per_period,
+            threads: recording.threads,
+        }
+    }
+
+    /// Seconds of the complete DEM to reach `t1 + m τ`.
+    pub fn total_dem(&self, m: f64) -> f64 {
+        self.until_t1 + m * self.tau_dem
+    }
+
+    /// Seconds of the extrapolated DEM to reach `t1 + m τ`: the DEM to `t1`, the pairing,
+    /// the collision file and `m` replayed periods.
+    pub fn total_extrapolated(&self, m: f64) -> f64 {
+        self.until_t1 + self.pairing + self.collision_file + m * self.tau_extra
+    }
+
+    /// Speedup of reaching `t1 + m τ` (None if the extrapolation cost nothing measurable).
+    pub fn speedup(&self, m: f64) -> Option<f64> {
+        ratio(self.total_dem(m), self.total_extrapolated(m))
+    }
+
+    /// Speedup of one period.
+    pub fn speedup_per_period(&self) -> Option<f64> {
+        ratio(self.tau_dem, self.tau_extra)
+    }
+
+    /// Periods after `t1` from which the extrapolation is faster than the complete DEM
+    /// (None if it never is).
+    pub fn break_even_periods(&self) -> Option<f64> {
+        let gain = self.tau_dem - self.tau_extra;
+        (gain > 0.0).then(|| (self.pairing + self.collision_file) / gain)
+    }
+}
+
+fn ratio(a: f64, b: f64) -> Option<f64> {
+    (b > 0.0 && a.is_finite() && b.is_finite()).then(|| a / b)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The paper's Table 6 (80 000 particles, one thread): 8580 s to t1, pairing 551 s,
+    /// collision file 7619 s, 3900 s per τ of DEM and 6 s per τ extrapolated.
+    #[test]
+    fn the_papers_table_6_is_reproduced() {
+        let recording = RecordingCosts {
+            seconds_to_t0: 8580.0 - 3900.0,
+            seconds_period: 3900.0 + 7619.0,
+            seconds_reference: 0.0,
+            seconds_recorder: 7619.0,
+            stage_seconds: Default::default(),
+            threads: 1,
+        };
+        let extrapolation = ExtrapolationCosts {
+            seconds_pairing: 0.0,
+            pairing_reused: true,
+            seconds_read_table: 0.0,
+            seconds_replay: 600.0,
+            seconds_per_period: 6.0,
+            rows_per_second: 0.0,
+            rows: 0,
+        };
+        let t = CostTable::new(&recording, 0, &extrapolation, Some(551.0));
+        assert_eq!(t.until_t1, 8580.0);
+        assert_eq!(t.tau_dem_source, DemPeriodSource::RecordedPeriod);
+        assert_eq!(t.total_dem(100.0), 398_580.0);
+        assert_eq!(t.total_extrapolated(100.0), 17_350.0);
+        assert!((t.speedup(100.0).unwrap() - 398_580.0 / 17_350.0).abs() < 1e-12);
+        assert_eq!(t.speedup_per_period(), Some(650.0));
+
+        // A reference run gives the DEM period; a missing pairing summary falls back.
+        let with_reference = RecordingCosts {
+            seconds_reference: 3.0 * 4000.0,
+            ..recording
+        };
+        let t = CostTable::new(&with_reference, 3, &extrapolation, None);
+        assert_eq!(t.tau_dem, 4000.0);
+        assert_eq!(t.tau_dem_source, DemPeriodSource::Reference { periods: 3 });
+        assert_eq!(t.pairing, 0.0);
+        assert_eq!(t.until_t1, 8580.0);
+    }
+}

@@ -1,0 +1,180 @@
+//! `tdex report`: a self-contained report of an extrapolation against its recording
+//! (DESIGN.md §7): `report.md` and `report.html` with the error table (Table 5 form), the
+//! cost table (Table 6 form) and SVG plots (Figures 7 and 9, errors, speedup, the field).
+
+mod content;
+mod costs;
+mod document;
+mod plots;
+
+use crate::cli::ReportPlan;
+use crate::compare::{self, Comparison};
+use anyhow::{Context, Result};
+use content::{DURATIONS_SVG, ERRORS_SVG, FIELD_SVG, MEANS_SVG, SPEEDUP_SVG};
+use costs::CostTable;
+use recorder::format::{ExtrapolationReader, RecordingReader};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// The report's own files; older copies are removed before a new report is written.
+const MARKDOWN: &str = "report.md";
+const HTML: &str = "report.html";
+const ALL_FILES: [&str; 7] = [
+    MARKDOWN,
+    HTML,
+    MEANS_SVG,
+    ERRORS_SVG,
+    SPEEDUP_SVG,
+    DURATIONS_SVG,
+    FIELD_SVG,
+];
+
+pub fn run(plan: &ReportPlan) -> Result<()> {
+    let recording = RecordingReader::open(&plan.recording)?;
+    let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
+    let comparison = compare::compare(&recording, &extrapolation, plan.cells, plan.seed)?;
+    let files = write(&plan.output, &recording, &extrapolation, &comparison)?;
+    for f in files {
+        println!("{}", f.display());
+    }
+    Ok(())
+}
+
+/// Writes the report into `dir` (created if missing); returns the files written. Each file
+/// goes to a temporary name and is renamed into place; the plots come first and the two
+/// reports last, so an interrupted run leaves no report that looks complete.
+pub fn write(
+    dir: &Path,
+    recording: &RecordingReader,
+    extrapolation: &ExtrapolationReader,
+    comparison: &Comparison,
+) -> Result<Vec<PathBuf>> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create the report directory", dir.display()))?;
+    for name in ALL_FILES {
+        let path = dir.join(name);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(e).with_context(|| {
+                    format!("{}: cannot remove the previous report file", path.display())
+                })
+            }
+            _ => {}
+        }
+    }
+    let info = recording.info();
+    let rec_path = recording.path().display().to_string();
+
+    let costs = match (recording.costs(), extrapolation.costs()) {
+        (Some(rc), Some(ec)) => {
+            let pairing_seconds = extrapolation
+                .info()
+                .pairing
+                .get("seconds")
+                .and_then(|v| v.as_f64());
+            Ok(CostTable::new(
+                rc,
+                info.reference_periods,
+                ec,
+                pairing_seconds,
+            ))
+        }
+        (None, _) => Err(format!(
+            "{rec_path} has no costs record (its writer was interrupted)"
+        )),
+        (_, None) => Err(format!(
+            "{} has no costs record (its writer was interrupted)",
+            extrapolation.path().display()
+        )),
+    };
+
+    let mut svgs: Vec<(&'static str, String)> = Vec::new();
+    let plot = |name: &str, r: Result<String>| {
+        r.with_context(|| format!("{}: cannot draw the plot", dir.join(name).display()))
+    };
+    svgs.push((MEANS_SVG, plot(MEANS_SVG, plots::means(comparison))?));
+    svgs.push((ERRORS_SVG, plot(ERRORS_SVG, plots::errors(comparison))?));
+    if let Ok(t) = &costs {
+        svgs.push((
+            SPEEDUP_SVG,
+            plot(SPEEDUP_SVG, plots::error_vs_speedup(comparison, t))?,
+        ));
+    }
+    if let Some(summary) = recording.summary() {
+        svgs.push((
+            DURATIONS_SVG,
+            plot(
+                DURATIONS_SVG,
+                plots::duration_cdf(
+                    &summary.duration_histogram,
+                    info.sample_every,
+                    info.dtc_max_steps,
+                ),
+            )?,
+        ));
+    }
+    let field = match comparison.periods.last() {
+        None => Err("no extrapolated t_k has a DEM reference".to_string()),
+        Some(last) => {
+            let k = last.k;
+            let dem = recording
+                .snapshot(k)
+                .with_context(|| format!("{rec_path}: cannot read the snapshot at t_{k}"))?;
+            let extra = extrapolation
+                .snapshots()
+                .with_context(|| {
+                    format!(
+                        "{}: cannot read the extrapolated snapshots",
+                        extrapolation.path().display()
+                    )
+                })?
+                .into_iter()
+                .find(|s| s.index == k);
+            match (dem, extra) {
+                (Some(dem), Some(extra)) => {
+                    svgs.push((FIELD_SVG, plot(FIELD_SVG, plots::field(&dem, &extra, k))?));
+                    Ok(k)
+                }
+                (None, _) => Err(format!("{rec_path} has no DEM snapshot at t_{k}")),
+                (_, None) => Err(format!(
+                    "{} has no snapshot at t_{k}",
+                    extrapolation.path().display()
+                )),
+            }
+        }
+    };
+
+    let doc = content::document(&content::Inputs {
+        recording_path: rec_path.clone(),
+        extrapolation_path: extrapolation.path().display().to_string(),
+        info,
+        extrapolation: extrapolation.info(),
+        summary: recording.summary(),
+        comparison,
+        costs,
+        field,
+        plots: svgs.iter().map(|(name, _)| *name).collect(),
+    });
+
+    let mut written = Vec::new();
+    for (name, svg) in &svgs {
+        written.push(write_atomically(dir, name, svg.as_bytes())?);
+    }
+    written.push(write_atomically(dir, MARKDOWN, doc.markdown().as_bytes())?);
+    written.push(write_atomically(dir, HTML, doc.html().as_bytes())?);
+    Ok(written)
+}
+
+/// Writes `dir/name` through a temporary file in `dir` renamed into place.
+fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+    let dest = dir.join(name);
+    let partial = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    let result = std::fs::File::create(&partial)
+        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
+        .and_then(|()| std::fs::rename(&partial, &dest));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&partial);
+        return Err(e).with_context(|| format!("{}: cannot write", dest.display()));
+    }
+    Ok(dest)
+}
