@@ -8,6 +8,7 @@ mod cli_compare;
 mod cli_record;
 mod cli_report;
 mod cli_run;
+mod cli_study;
 mod drum;
 mod physics_collision;
 mod physics_conduction;

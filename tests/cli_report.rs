@@ -1,0 +1,224 @@
+//! `tdex report` end to end on the tiny drum (issue 5, must-show 3): the SVGs are valid XML
+//! with drawn elements, every Markdown link resolves, the HTML references the plots, the
+//! tables hold numbers, and the same inputs give the same bytes.
+
+use crate::cli_run::TINY_CASE;
+use crate::util::*;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const PLOTS: [&str; 5] = [
+    "means.svg",
+    "eps_rel.svg",
+    "error_vs_speedup.svg",
+    "duration_cdf.svg",
+    "field.svg",
+];
+
+fn tdex_ok(args: &[&str]) -> String {
+    let o = run_tdex(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// Every file of `dir` by name, with its bytes.
+fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// The targets of the Markdown links and images `[..](target)`.
+fn markdown_links(md: &str) -> Vec<String> {
+    md.match_indices("](")
+        .map(|(i, _)| {
+            let rest = &md[i + 2..];
+            rest[..rest.find(')').expect("a link is closed")].to_string()
+        })
+        .collect()
+}
+
+/// The numeric cells of the Markdown table row whose first cell is `label`.
+fn table_row(md: &str, label: &str) -> Vec<f64> {
+    let line = md
+        .lines()
+        .find(|l| l.starts_with(&format!("| {label} |")))
+        .unwrap_or_else(|| panic!("no table row '{label}' in\n{md}"));
+    line.trim_matches('|')
+        .split('|')
+        .skip(1)
+        .map(|c| {
+            c.trim()
+                .parse::<f64>()
+                .unwrap_or_else(|_| panic!("'{c}' in row '{label}' is not a number"))
+        })
+        .collect()
+}
+
+fn check_svg(name: &str, bytes: &[u8]) {
+    let text = std::str::from_utf8(bytes).unwrap_or_else(|e| panic!("{name}: not UTF-8: {e}"));
+    let doc = roxmltree::Document::parse(text).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let root = doc.root_element();
+    assert_eq!(root.tag_name().name(), "svg", "{name}: root element");
+    for dim in ["width", "height"] {
+        let v: f64 = root
+            .attribute(dim)
+            .unwrap_or_else(|| panic!("{name}: no {dim}"))
+            .parse()
+            .unwrap();
+        assert!(v > 0.0, "{name}: {dim} = {v}");
+    }
+    let count = |tags: &[&str]| {
+        root.descendants()
+            .filter(|n| tags.contains(&n.tag_name().name()))
+            .count()
+    };
+    assert!(
+        count(&["path", "line", "circle", "polyline"]) > 0,
+        "{name}: nothing drawn"
+    );
+    assert!(count(&["text"]) >= 3, "{name}: no axis labels");
+}
+
+#[test]
+fn report_writes_valid_svgs_and_resolving_links() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("tiny.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    let run = dir.path().join("run.mcap");
+    let extra = dir.path().join("extra.mcap");
+    let out = dir.path().join("report");
+    let (case_s, run_s, extra_s, out_s) = (
+        case.to_str().unwrap(),
+        run.to_str().unwrap(),
+        extra.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    tdex_ok(&[
+        "record",
+        case_s,
+        "-o",
+        run_s,
+        "--tau-rev",
+        "0.25",
+        "--reference",
+        "2",
+    ]);
+    tdex_ok(&["extrapolate", run_s, "--periods", "2", "-o", extra_s]);
+    let stdout = tdex_ok(&["report", run_s, extra_s, "-o", out_s, "--cells", "20"]);
+
+    let written = files(&out);
+    let mut expected: Vec<String> = PLOTS.iter().map(|s| s.to_string()).collect();
+    expected.extend(["report.md".into(), "report.html".into()]);
+    expected.sort();
+    assert_eq!(
+        written.keys().cloned().collect::<Vec<_>>(),
+        expected,
+        "exactly the report's files, no temporary ones"
+    );
+    for name in &expected {
+        assert!(
+            stdout.lines().any(|l| l.ends_with(name.as_str())),
+            "stdout does not list {name}: {stdout}"
+        );
+    }
+    for plot in PLOTS {
+        check_svg(plot, &written[plot]);
+    }
+
+    // Every Markdown link names a file of the report, and every plot is linked.
+    let md = String::from_utf8(written["report.md"].clone()).unwrap();
+    let links = markdown_links(&md);
+    for target in &links {
+        assert!(
+            out.join(target).is_file(),
+            "report.md links to '{target}', which is not in {}",
+            out.display()
+        );
+    }
+    for plot in PLOTS {
+        assert!(
+            links.iter().any(|l| l == plot),
+            "report.md does not link {plot}"
+        );
+    }
+
+    // The HTML is well-formed and shows the same plots.
+    let html = String::from_utf8(written["report.html"].clone()).unwrap();
+    let doc = roxmltree::Document::parse_with_options(
+        &html,
+        roxmltree::ParsingOptions {
+            allow_dtd: true,
+            ..Default::default()
+        },
+    )
+    .expect("report.html is well-formed");
+    let images: Vec<&str> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("img"))
+        .filter_map(|n| n.attribute("src"))
+        .collect();
+    for plot in PLOTS {
+        assert!(
+            images.contains(&plot),
+            "report.html shows no {plot}: {images:?}"
+        );
+    }
+    assert!(!html.contains("<script"));
+
+    // The tables hold numbers: the errors at t_2 and t_3, the costs for 100 τ.
+    assert!(md.contains("| Extrapolation step | t_2 | t_3 |"), "{md}");
+    let eps_abs = table_row(&md, "ε_abs (K)");
+    assert_eq!(eps_abs.len(), 2);
+    assert!(eps_abs.iter().all(|e| e.is_finite() && *e >= 0.0));
+    assert_eq!(table_row(&md, "ε_rel (%)").len(), 2);
+    let until_t1 = table_row(&md, "Until t1 (s)");
+    assert!(
+        until_t1[0] > 0.0 && until_t1[0] == until_t1[1],
+        "{until_t1:?}"
+    );
+    assert_eq!(table_row(&md, "Pairing (s)")[0], 0.0);
+    assert_eq!(table_row(&md, "Collision file (s)")[0], 0.0);
+    let per_tau = table_row(&md, "For one τ (s)");
+    assert!(per_tau.iter().all(|s| *s > 0.0), "{per_tau:?}");
+    let total = table_row(&md, "Total for 100 τ (s)");
+    assert_eq!(total.len(), 2);
+    assert!(
+        total[0] > until_t1[0] && total[1] > until_t1[1],
+        "{total:?}"
+    );
+    assert!(md.contains("Speedup: **"), "{md}");
+    assert!(md.contains("thread(s)"), "{md}");
+
+    // Same inputs, same bytes: a second report over the first one.
+    tdex_ok(&["report", run_s, extra_s, "-o", out_s, "--cells", "20"]);
+    assert_eq!(files(&out), written, "the report is not deterministic");
+}
+
+#[test]
+fn report_refuses_a_file_as_output_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("not_a_dir");
+    std::fs::write(&file, "x").unwrap();
+    let o = run_tdex(&[
+        "report",
+        "run.mcap",
+        "extra.mcap",
+        "-o",
+        file.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("not_a_dir"), "{err}");
+}
