@@ -11,6 +11,7 @@ mod pair;
 mod record;
 mod report;
 mod run;
+mod study;
 
 use std::process::ExitCode;
 
@@ -39,6 +40,7 @@ fn main() -> ExitCode {
         cli::Plan::Compare(p) => compare::run(&p),
         cli::Plan::Report(p) => report::run(&p),
         cli::Plan::Demo(p) => demo::run(&p),
+        cli::Plan::Study(p) => study::run(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -147,6 +147,10 @@ pub enum Command {
     /// Benchmarks (figures for docs/benchmarks.md).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Parameter studies (Haydar §3.2–3.3): sampling (n, Δt_c^max), pairing period τ, and
+    /// flow regimes (drum speed), each recorded, extrapolated and compared with the DEM.
+    #[command(subcommand)]
+    Study(StudyCommand),
     /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
     /// suggested n, costs. Reads the whole table, so it also checks the file.
     Inspect {
@@ -183,6 +187,108 @@ pub enum BenchCommand {
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
+    },
+}
+
+/// Flags shared by the studies.
+#[derive(Debug, clap::Args)]
+pub struct StudyCommon {
+    /// The case file (TOML).
+    pub case: PathBuf,
+    /// The study directory (created if missing): recordings, extrapolations, study.md,
+    /// study.json and the SVG plots.
+    #[arg(short = 'o', long = "output")]
+    pub output: Option<PathBuf>,
+    /// Voronoi cells of the comparison.
+    #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+    pub cells: usize,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Print the study as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum StudyCommand {
+    /// Sampling study (Figure 10): every (n, Δt_c^max) with Δt_c^max a multiple of n, all
+    /// sampled from ONE DEM run, each extrapolated K periods against the DEM reference.
+    Sampling {
+        #[command(flatten)]
+        common: StudyCommon,
+        /// Sampling factors n (steps), comma-separated.
+        #[arg(long = "n", default_value = "1,5,10,20", allow_hyphen_values = true)]
+        n: String,
+        /// Δt_c^max values (steps), comma-separated.
+        #[arg(
+            long = "dtc-max",
+            default_value = "10,50,100,200",
+            allow_hyphen_values = true
+        )]
+        dtc_max: String,
+        /// Periods extrapolated and simulated by the DEM for reference.
+        #[arg(long, default_value_t = 6)]
+        periods: u32,
+        /// Period τ as a fraction of a drum revolution.
+        #[arg(long = "tau-rev", default_value_t = 1.0, allow_negative_numbers = true)]
+        tau_rev: f64,
+    },
+    /// Pairing-period study (Figures 13–15, Table 8): per τ, record and extrapolate over the
+    /// same simulated time (R revolutions) against a DEM reference.
+    Period {
+        #[command(flatten)]
+        common: StudyCommon,
+        /// Periods τ as fractions of a revolution, comma-separated.
+        #[arg(
+            long = "tau-rev",
+            default_value = "0.25,0.5,1",
+            allow_hyphen_values = true
+        )]
+        tau_rev: String,
+        /// Revolutions covered after t1 by every τ (R / τ_rev periods each).
+        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+        revolutions: f64,
+        /// Sampling factor n (steps).
+        #[arg(long = "n", default_value_t = 10)]
+        n: u32,
+        /// Δt_c^max in steps (a multiple of n).
+        #[arg(long = "dtc-max", default_value_t = 100)]
+        dtc_max: u32,
+    },
+    /// Flow-regime study (Figures 11–12): per drum rotation period, the Froude number, the
+    /// regime (Mellmann 2001), the dynamic angle of repose, the active-layer thickness and
+    /// (where particles move relative to the drum) the extrapolation error and speedup.
+    Regimes {
+        #[command(flatten)]
+        common: StudyCommon,
+        /// Drum rotation periods (s per revolution), comma-separated.
+        #[arg(
+            long = "rev-period",
+            default_value = "15,5,0.1",
+            allow_hyphen_values = true
+        )]
+        rev_period: String,
+        /// Periods extrapolated and simulated by the DEM for reference.
+        #[arg(long, default_value_t = 2)]
+        periods: u32,
+        /// Period τ as a fraction of a revolution.
+        #[arg(long = "tau-rev", default_value_t = 1.0, allow_negative_numbers = true)]
+        tau_rev: f64,
+        /// Sampling factor n (steps).
+        #[arg(long = "n", default_value_t = 10)]
+        n: u32,
+        /// Δt_c^max in steps (a multiple of n).
+        #[arg(long = "dtc-max", default_value_t = 100)]
+        dtc_max: u32,
+        /// No relative motion below this mean speed relative to solid-body rotation, as a
+        /// fraction of the wall speed ωR: extrapolation is then refused.
+        #[arg(
+            long = "min-relative",
+            default_value_t = crate::study::flow::MIN_RELATIVE,
+            allow_negative_numbers = true
+        )]
+        min_relative: f64,
     },
 }
 

@@ -7,5 +7,5 @@ pub use args::Cli;
 pub(crate) use plan::record_options;
 pub use plan::{
     BenchRecordPlan, ComparePlan, DemoPlan, ExtrapolatePlan, InspectPlan, PairPlan, Plan,
-    RecordPlan, ReportPlan, RunPlan, UsageError,
+    RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan, UsageError,
 };

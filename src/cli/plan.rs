@@ -1,6 +1,6 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
-use super::args::{BenchCommand, Cli, Command};
+use super::args::{BenchCommand, Cli, Command, StudyCommand, StudyCommon};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::format::AreaEncoding;
@@ -31,6 +31,47 @@ pub enum Plan {
     Compare(ComparePlan),
     Report(ReportPlan),
     Demo(DemoPlan),
+    Study(StudyPlan),
+}
+
+/// `tdex study ...`: the case, the study directory and what to run.
+pub struct StudyPlan {
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub output: PathBuf,
+    pub cells: usize,
+    pub threads: usize,
+    pub json: bool,
+    pub kind: StudyKind,
+}
+
+pub enum StudyKind {
+    /// One DEM run, one recording per `(n, Δt_c^max)` in `runs`.
+    Sampling {
+        runs: Vec<RecordOptions>,
+        /// Combinations skipped: Δt_c^max not a multiple of n.
+        skipped: Vec<(u32, u32)>,
+        tau_rev: f64,
+    },
+    /// One recording per τ, each extrapolated over the same simulated time.
+    Period {
+        runs: Vec<(f64, RecordOptions)>,
+        revolutions: f64,
+    },
+    /// One recording per drum speed (the case with its rotation period replaced).
+    Regimes {
+        runs: Vec<RegimeRun>,
+        tau_rev: f64,
+        min_relative: f64,
+    },
+}
+
+pub struct RegimeRun {
+    pub rotation_period: f64,
+    pub case: Case,
+    pub case_toml: String,
+    pub options: RecordOptions,
 }
 
 pub struct DemoPlan {
@@ -234,6 +275,7 @@ impl Plan {
                 check_output_dir(&output)?;
                 Ok(Plan::Demo(DemoPlan { output, threads }))
             }
+            Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
             Command::Bench(BenchCommand::Record {
                 case,
                 tau_rev,
@@ -382,4 +424,246 @@ fn check_output_dir(dir: &std::path::Path) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// A comma-separated list of values for `flag`: no empty list, no empty or unparsable item;
+/// repeated values are kept once, in the order given.
+fn parse_list<T: std::str::FromStr + PartialEq + Copy>(
+    flag: &str,
+    text: &str,
+    kind: &str,
+) -> Result<Vec<T>> {
+    let mut values = Vec::new();
+    if text.trim().is_empty() {
+        return Err(usage(format!(
+            "{flag} is empty: give at least one {kind}, comma-separated"
+        )));
+    }
+    for item in text.split(',').map(str::trim) {
+        let v: T = item.parse().map_err(|_| {
+            usage(format!(
+                "{flag} = {text:?}: {item:?} is not {kind} (give a comma-separated list)"
+            ))
+        })?;
+        if !values.contains(&v) {
+            values.push(v);
+        }
+    }
+    Ok(values)
+}
+
+/// Whole-number lists (`--n`, `--dtc-max`): every value ≥ 1.
+fn positive_steps(flag: &str, text: &str) -> Result<Vec<u32>> {
+    let values: Vec<i64> = parse_list(flag, text, "a whole number of steps")?;
+    values
+        .into_iter()
+        .map(|v| {
+            u32::try_from(v).ok().filter(|v| *v > 0).ok_or_else(|| {
+                usage(format!(
+                    "{flag} = {v} is not allowed: give whole numbers of steps ≥ 1"
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Real-valued lists (`--tau-rev`, `--rev-period`): every value finite and > 0.
+fn positive_reals(flag: &str, text: &str, what: &str) -> Result<Vec<f64>> {
+    let values: Vec<f64> = parse_list(flag, text, "a number")?;
+    for v in &values {
+        if !(v.is_finite() && *v > 0.0) {
+            return Err(usage(format!(
+                "{flag} = {v} is not allowed: give {what} > 0"
+            )));
+        }
+    }
+    Ok(values)
+}
+
+/// The case text with `drum.rotation_period` replaced (the line in the `[drum]` table).
+fn with_rotation_period(text: &str, period: f64) -> Option<String> {
+    let mut table = String::new();
+    let mut replaced = false;
+    let lines: Vec<String> = text
+        .lines()
+        .map(|line| {
+            let t = line.trim_start();
+            if t.starts_with('[') {
+                table = t.trim_end().to_string();
+            }
+            let key = t.split('=').next().unwrap_or("").trim();
+            if !replaced && table.starts_with("[drum]") && key == "rotation_period" {
+                replaced = true;
+                format!("rotation_period = {period:?} # set by tdex study regimes")
+            } else {
+                line.to_string()
+            }
+        })
+        .collect();
+    replaced.then(|| lines.join("\n") + "\n")
+}
+
+fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
+    let common_of = |c: &StudyCommon| -> Result<(usize, PathBuf)> {
+        let threads = threads(c.threads)?;
+        check_cells(c.cells)?;
+        Ok((threads, c.output.clone().unwrap_or_default()))
+    };
+    let (common, kind_name) = match &study {
+        StudyCommand::Sampling { common, .. } => (common, "sampling"),
+        StudyCommand::Period { common, .. } => (common, "period"),
+        StudyCommand::Regimes { common, .. } => (common, "regimes"),
+    };
+    let (threads, mut output) = common_of(common)?;
+    if output.as_os_str().is_empty() {
+        output = PathBuf::from(format!("tdex-study-{kind_name}"));
+    }
+    check_output_dir(&output)?;
+    let (case, case_toml) = recorder::case::load_with_text(&common.case)?;
+    let kind = match &study {
+        StudyCommand::Sampling {
+            n,
+            dtc_max,
+            periods,
+            tau_rev,
+            ..
+        } => {
+            let ns = positive_steps("--n", n)?;
+            let dtcs = positive_steps("--dtc-max", dtc_max)?;
+            if *periods == 0 {
+                return Err(usage(
+                    "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
+                ));
+            }
+            let mut runs = Vec::new();
+            let mut skipped = Vec::new();
+            for &n in &ns {
+                for &d in &dtcs {
+                    if d % n != 0 {
+                        skipped.push((n, d));
+                        continue;
+                    }
+                    runs.push(record_options(
+                        &case,
+                        None,
+                        Some(*tau_rev),
+                        n,
+                        d,
+                        *periods,
+                        false,
+                    )?);
+                }
+            }
+            if runs.is_empty() {
+                return Err(usage(format!(
+                    "--n {n} --dtc-max {dtc_max}: no Δt_c^max is a multiple of any n, so there is nothing to run"
+                )));
+            }
+            StudyKind::Sampling {
+                runs,
+                skipped,
+                tau_rev: *tau_rev,
+            }
+        }
+        StudyCommand::Period {
+            tau_rev,
+            revolutions,
+            n,
+            dtc_max,
+            ..
+        } => {
+            let taus = positive_reals("--tau-rev", tau_rev, "fractions of a revolution")?;
+            if !(revolutions.is_finite() && *revolutions > 0.0) {
+                return Err(usage(format!(
+                    "--revolutions = {revolutions} is not allowed: give a number of revolutions > 0"
+                )));
+            }
+            let mut runs = Vec::new();
+            for &f in &taus {
+                let k = revolutions / f;
+                let periods = k.round();
+                if periods < 1.0 || (k - periods).abs() > 1e-9 * k {
+                    return Err(usage(format!(
+                        "--tau-rev {f} with --revolutions {revolutions}: {revolutions} revolutions are {k} periods of {f} revolution; they must be a whole number ≥ 1"
+                    )));
+                }
+                runs.push((
+                    f,
+                    record_options(&case, None, Some(f), *n, *dtc_max, periods as u32, false)?,
+                ));
+            }
+            StudyKind::Period {
+                runs,
+                revolutions: *revolutions,
+            }
+        }
+        StudyCommand::Regimes {
+            rev_period,
+            periods,
+            tau_rev,
+            n,
+            dtc_max,
+            min_relative,
+            ..
+        } => {
+            let speeds = positive_reals("--rev-period", rev_period, "rotation periods in seconds")?;
+            if *periods == 0 {
+                return Err(usage(
+                    "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
+                ));
+            }
+            if !(min_relative.is_finite() && *min_relative >= 0.0) {
+                return Err(usage(format!(
+                    "--min-relative = {min_relative} is not allowed: give a fraction of the wall speed ≥ 0"
+                )));
+            }
+            let mut runs = Vec::new();
+            for &t in &speeds {
+                let text = with_rotation_period(&case_toml, t).ok_or_else(|| {
+                    usage(format!(
+                        "{}: no `rotation_period = ...` line in its [drum] table to vary",
+                        common.case.display()
+                    ))
+                })?;
+                let case_t = recorder::case::parse(&text, &common.case)?;
+                // no DEM reference where the extrapolation is refused anyway (Fr ≥ 1)
+                let reference = if crate::study::flow::froude(&case_t) >= 1.0 {
+                    0
+                } else {
+                    *periods
+                };
+                let options = record_options(
+                    &case_t,
+                    None,
+                    Some(*tau_rev),
+                    *n,
+                    *dtc_max,
+                    reference,
+                    false,
+                )
+                .map_err(|e| usage(format!("--rev-period {t}: {e}")))?;
+                runs.push(RegimeRun {
+                    rotation_period: t,
+                    case: case_t,
+                    case_toml: text,
+                    options,
+                });
+            }
+            StudyKind::Regimes {
+                runs,
+                tau_rev: *tau_rev,
+                min_relative: *min_relative,
+            }
+        }
+    };
+    Ok(StudyPlan {
+        case_path: common.case.clone(),
+        case_toml,
+        case,
+        output,
+        cells: common.cells,
+        threads,
+        json: common.json,
+        kind,
+    })
 }

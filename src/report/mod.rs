@@ -3,7 +3,7 @@
 //! cost table (Table 6 form) and SVG plots (Figures 7 and 9, errors, speedup, the field).
 
 mod content;
-mod costs;
+pub(crate) mod costs;
 mod document;
 mod plots;
 

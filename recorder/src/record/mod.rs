@@ -5,7 +5,10 @@ pub mod recording;
 pub mod sampler;
 pub mod splitter;
 
-pub use recording::{record, record_from_t0, run_to_t0, Phase, RecordError, RecordOptions};
+pub use recording::{
+    record, record_from_t0, record_many_from_t0, run_to_t0, Phase, RecordError, RecordJob,
+    RecordOptions,
+};
 pub use sampler::ContactSampler;
 
 /// One row of the collision table, times in DEM steps from the recording's origin.

@@ -265,3 +265,129 @@ fn recording_info(
         conductivity: case.material.conductivity,
     }
 }
+
+/// One recording of [`record_many_from_t0`]: its settings and its file.
+#[derive(Debug, Clone)]
+pub struct RecordJob<'a> {
+    pub options: RecordOptions,
+    pub dest: &'a Path,
+}
+
+/// Records several samplings of the same DEM run: one simulation standing at `t0` is stepped
+/// once through the period and the reference periods, and every job's sampler is fed the
+/// contact list at its own steps (`k` a multiple of its `n`). The DEM trajectory does not
+/// depend on the sampling (sampling only reads the state), so each file holds the table and
+/// snapshots that [`record_from_t0`] would write for its options alone; only the costs differ:
+/// each file's `seconds_period` is the DEM's stepping time plus its own sampler's time (its
+/// `seconds_recorder`), measured on the calling thread (no recorder thread here). Jobs must
+/// share `period_steps` and `reference_periods`. `tdex record` does not use this function.
+pub fn record_many_from_t0(
+    sim: &mut Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    jobs: &[RecordJob],
+    seconds_to_t0: f64,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Vec<RecordingSummary>, RecordError> {
+    let Some(first) = jobs.first() else {
+        return Ok(Vec::new());
+    };
+    let (period_steps, reference_periods) =
+        (first.options.period_steps, first.options.reference_periods);
+    if jobs.iter().any(|j| {
+        j.options.period_steps != period_steps || j.options.reference_periods != reference_periods
+    }) {
+        return Err(RecordError::Settings(
+            "the recordings of one run must share τ and the reference periods".into(),
+        ));
+    }
+    let mut samplers = jobs
+        .iter()
+        .map(|j| check(&j.options))
+        .collect::<Result<Vec<_>, _>>()?;
+    let mut writers = Vec::with_capacity(jobs.len());
+    let t0 = sim.snapshot(0);
+    for j in jobs {
+        let info = recording_info(sim, case_path, case_toml, &j.options);
+        let mut writer = RecordingWriter::create(j.dest, info)?;
+        writer.write_snapshot(&t0)?;
+        writers.push(writer);
+    }
+
+    let mut dem_seconds = 0.0;
+    let mut sampler_seconds = vec![0.0; jobs.len()];
+    let every_min = jobs
+        .iter()
+        .map(|j| j.options.sample_every as u64)
+        .min()
+        .expect("at least one job");
+    let mut contacts: Vec<(u32, u32, f64)> = Vec::new();
+    for k in 0..period_steps {
+        let t = Instant::now();
+        sim.step();
+        dem_seconds += t.elapsed().as_secs_f64();
+        let wanted: Vec<usize> = (0..jobs.len())
+            .filter(|&i| k % jobs[i].options.sample_every as u64 == 0)
+            .collect();
+        if !wanted.is_empty() {
+            contacts.clear();
+            contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
+            for i in wanted {
+                let t = Instant::now();
+                samplers[i].sample(k, contacts.iter().copied());
+                writers[i].push_rows(samplers[i].drain_ready())?;
+                sampler_seconds[i] += t.elapsed().as_secs_f64();
+            }
+        }
+        let done = k + 1;
+        if done % every_min == 0 {
+            sim.check_inside()?;
+        }
+        if done % REPORT_EVERY == 0 || done == period_steps {
+            progress(Phase::Period, done, period_steps);
+        }
+    }
+    let t1 = sim.snapshot(1);
+    for (i, w) in writers.iter_mut().enumerate() {
+        let t = Instant::now();
+        w.push_rows(samplers[i].finish())?;
+        w.write_snapshot(&t1)?;
+        sampler_seconds[i] += t.elapsed().as_secs_f64();
+    }
+
+    let reference_start = Instant::now();
+    let reference_steps = reference_periods as u64 * period_steps;
+    for period in 0..reference_periods {
+        let done = period as u64 * period_steps;
+        sim.run(period_steps, REPORT_EVERY, &mut |s| {
+            progress(Phase::Reference, done + s, reference_steps)
+        })?;
+        let snapshot = sim.snapshot(period + 2);
+        for w in writers.iter_mut() {
+            w.write_snapshot(&snapshot)?;
+        }
+    }
+    let seconds_reference = reference_start.elapsed().as_secs_f64();
+    let stage_seconds: std::collections::BTreeMap<String, f64> = sim
+        .counters
+        .stages()
+        .iter()
+        .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
+        .collect();
+    writers
+        .into_iter()
+        .zip(samplers)
+        .zip(sampler_seconds)
+        .map(|((writer, sampler), recorder_seconds)| {
+            let costs = RecordingCosts {
+                seconds_to_t0,
+                seconds_period: dem_seconds + recorder_seconds,
+                seconds_reference,
+                seconds_recorder: recorder_seconds,
+                stage_seconds: stage_seconds.clone(),
+                threads: rayon::current_num_threads(),
+            };
+            Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+        })
+        .collect()
+}

@@ -1,0 +1,224 @@
+//! `tdex study`: parameter studies over recordings (Haydar §3.2–3.3). Each run is recorded,
+//! extrapolated (by `tdex extrapolate` in a child process, so its own output stays out of
+//! the study's) and compared in-process with the DEM reference; the study writes a grid on
+//! the terminal (or JSON), `study.json`, `study.md` and SVG plots into its directory.
+
+pub mod flow;
+mod period;
+mod plots;
+mod regimes;
+mod sampling;
+
+use crate::cli::{StudyKind, StudyPlan};
+use crate::compare::{self, Comparison};
+use anyhow::{Context, Result};
+// the study's speedups are the report's (Table 6 form)
+use crate::report::costs::{CostTable, TABLE_PERIODS};
+use indicatif::{ProgressBar, ProgressStyle};
+use recorder::format::{ExtrapolationReader, RecordingReader};
+use recorder::record::Phase;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+pub fn run(plan: &StudyPlan) -> Result<()> {
+    std::fs::create_dir_all(&plan.output)
+        .with_context(|| format!("cannot create {}", plan.output.display()))?;
+    match &plan.kind {
+        StudyKind::Sampling {
+            runs,
+            skipped,
+            tau_rev,
+        } => sampling::run(plan, runs, skipped, *tau_rev),
+        StudyKind::Period { runs, revolutions } => period::run(plan, runs, *revolutions),
+        StudyKind::Regimes {
+            runs,
+            tau_rev,
+            min_relative,
+        } => regimes::run(plan, runs, *tau_rev, *min_relative),
+    }
+}
+
+/// A progress bar on stderr for the DEM phases (hidden with `--json`).
+pub(crate) fn dem_bar(hidden: bool, label: &str) -> ProgressBar {
+    if hidden {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{label} {{msg:>9}} [{{bar:40}}] {{pos}}/{{len}} steps ({{eta}} left)"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+/// The progress callback of the recorder, drawing on `bar`.
+pub(crate) fn on_phase(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
+    move |phase, done, total| {
+        let name = match phase {
+            Phase::Settle => "settle",
+            Phase::SpinUp => "spin-up",
+            Phase::Period => "record",
+            Phase::Reference => "reference",
+        };
+        if bar.message() != name {
+            bar.set_message(name);
+            bar.set_length(total);
+            bar.reset_eta();
+        }
+        bar.set_position(done);
+    }
+}
+
+/// A bar over the runs of a stage (extrapolate + compare), hidden with `--json`.
+pub(crate) fn runs_bar(hidden: bool, total: usize, what: &str) -> ProgressBar {
+    if hidden {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(total as u64);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{what} [{{bar:40}}] {{pos}}/{{len}} runs ({{elapsed}}) {{msg}}"
+        ))
+        .expect("static template")
+        .progress_chars("=> "),
+    );
+    bar
+}
+
+/// The errors and costs of one recording extrapolated against its DEM reference.
+#[derive(Debug, Clone, Serialize)]
+pub struct Outcome {
+    pub recording: String,
+    pub extrapolation: Option<String>,
+    pub rows: u64,
+    pub table_bytes: u64,
+    pub bytes_per_row: f64,
+    /// Periods extrapolated (and compared).
+    pub periods: u32,
+    pub replay_seconds_per_period: Option<f64>,
+    /// The compared `t_k` (k ≥ 2) and, at each, ε_rel and the Eq. 10 error of the period
+    /// ending there (fractions, not %; null where undefined).
+    pub k: Vec<u32>,
+    pub eps_rel: Vec<Option<f64>>,
+    pub eps_rel_max: Option<f64>,
+    pub energy_error: Vec<Option<f64>>,
+    pub energy_error_mean_abs: Option<f64>,
+    /// Complete DEM seconds / extrapolated DEM seconds to reach t1 + 100 τ (Table 6 form).
+    pub speedup_100: Option<f64>,
+    /// Why there is no extrapolation (the extrapolation's error or a refusal).
+    pub error: Option<String>,
+    #[serde(skip)]
+    pub comparison: Option<Comparison>,
+}
+
+impl Outcome {
+    /// The recording's table alone (no extrapolation), with `error` saying why.
+    pub fn table_only(rec: &RecordingReader, error: String) -> Self {
+        let rows = rec.summary().map_or(0, |s| s.rows);
+        Outcome {
+            recording: rec.path().display().to_string(),
+            extrapolation: None,
+            rows,
+            table_bytes: rec.table_bytes(),
+            bytes_per_row: rec.table_bytes() as f64 / rows.max(1) as f64,
+            periods: 0,
+            replay_seconds_per_period: None,
+            k: Vec::new(),
+            eps_rel: Vec::new(),
+            eps_rel_max: None,
+            energy_error: Vec::new(),
+            energy_error_mean_abs: None,
+            speedup_100: None,
+            error: Some(error),
+            comparison: None,
+        }
+    }
+}
+
+/// Extrapolates `recording` over `periods` into `extra` with `tdex extrapolate` (a child
+/// process of this executable) and compares it with the DEM reference.
+pub fn evaluate(
+    recording: &Path,
+    extra: &Path,
+    periods: u32,
+    threads: usize,
+    cells: usize,
+) -> Result<Outcome> {
+    let rec = RecordingReader::open(recording)?;
+    let exe = std::env::current_exe().context("cannot find the tdex executable")?;
+    let out = std::process::Command::new(exe)
+        .arg("extrapolate")
+        .arg(recording)
+        .args([
+            "--periods",
+            &periods.to_string(),
+            "--threads",
+            &threads.to_string(),
+        ])
+        .arg("-o")
+        .arg(extra)
+        .arg("--json")
+        .output()
+        .context("cannot start `tdex extrapolate`")?;
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        let message = stderr
+            .lines()
+            .rev()
+            .find(|l| !l.trim().is_empty())
+            .unwrap_or("tdex extrapolate failed")
+            .trim_start_matches("error: ")
+            .to_string();
+        return Ok(Outcome::table_only(&rec, message));
+    }
+    let ext = ExtrapolationReader::open(extra)?;
+    let c = compare::compare(&rec, &ext, cells, compare::DEFAULT_SEED)?;
+    let mut o = Outcome::table_only(&rec, String::new());
+    o.error = None;
+    o.extrapolation = Some(extra.display().to_string());
+    o.periods = periods;
+    o.replay_seconds_per_period = ext.costs().map(|c| c.seconds_per_period);
+    o.k = c.periods.iter().map(|p| p.k).collect();
+    o.eps_rel = c.periods.iter().map(|p| p.eps_rel).collect();
+    o.eps_rel_max = o.eps_rel.iter().flatten().copied().reduce(f64::max);
+    o.energy_error = c.periods.iter().map(|p| p.energy_error).collect();
+    let abs: Vec<f64> = o.energy_error.iter().flatten().map(|e| e.abs()).collect();
+    o.energy_error_mean_abs = (!abs.is_empty()).then(|| abs.iter().sum::<f64>() / abs.len() as f64);
+    if let (Some(rc), Some(ec)) = (rec.costs(), ext.costs()) {
+        let pairing = ext.info().pairing.get("seconds").and_then(|v| v.as_f64());
+        let table = CostTable::new(rc, rec.info().reference_periods, ec, pairing);
+        o.speedup_100 = table.speedup(TABLE_PERIODS as f64);
+    }
+    o.comparison = Some(c);
+    Ok(o)
+}
+
+/// `x` as a percentage with 3 decimals, or "-".
+pub(crate) fn pct(x: Option<f64>) -> String {
+    x.map_or("-".into(), |v| format!("{:.3}", 100.0 * v))
+}
+
+pub(crate) fn num(x: Option<f64>, digits: usize) -> String {
+    x.map_or("-".into(), |v| format!("{v:.digits$}"))
+}
+
+/// Writes `dir/name` (through a temporary file renamed into place); returns its path.
+pub(crate) fn write_file(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
+    let dest = dir.join(name);
+    let partial = dir.join(format!(".{name}.partial-{}", std::process::id()));
+    std::fs::write(&partial, text)
+        .and_then(|()| std::fs::rename(&partial, &dest))
+        .with_context(|| format!("{}: cannot write", dest.display()))?;
+    Ok(dest)
+}
+
+/// The paths of one run's files in the study directory.
+pub(crate) fn run_paths(dir: &Path, stem: &str) -> (PathBuf, PathBuf) {
+    (
+        dir.join(format!("{stem}.mcap")),
+        dir.join(format!("{stem}.extra.mcap")),
+    )
+}

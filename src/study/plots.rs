@@ -1,0 +1,175 @@
+//! The study's SVG plots, in the report's style (plotters' SVG backend, text as SVG
+//! `<text>`, 820×520, sans-serif; the same inputs give the same bytes). The report's own
+//! drawing helpers are private to `src/report/plots.rs`, so the few needed here are below.
+
+use anyhow::Result;
+use plotters::prelude::*;
+use std::ops::Range;
+
+const FONT: &str = "sans-serif";
+const SIZE: (u32, u32) = (820, 520);
+const HOT: RGBColor = RGBColor(200, 35, 35);
+const COLD: RGBColor = RGBColor(35, 80, 200);
+const GREY: RGBColor = RGBColor(120, 120, 120);
+
+/// A padded range over the finite values; never empty.
+fn span(values: impl IntoIterator<Item = f64>, pad: f64) -> Range<f64> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values.into_iter().filter(|v| v.is_finite()) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if lo > hi {
+        return 0.0..1.0;
+    }
+    if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(1e-300) {
+        let d = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
+        return lo - d..hi + d;
+    }
+    let d = pad * (hi - lo);
+    lo - d..hi + d
+}
+
+fn tick(v: f64) -> String {
+    if v == 0.0 {
+        return "0".into();
+    }
+    if !(1e-3..1e6).contains(&v.abs()) {
+        return format!("{v:.1e}");
+    }
+    let s = format!("{v:.4}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// Labelled points `(x, y, label)`; a message instead when there are none.
+pub fn scatter(
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    points: &[(f64, f64, String)],
+) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let x = span(points.iter().map(|p| p.0), 0.12);
+        let y = span(points.iter().map(|p| p.1).chain([0.0]), 0.12);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FONT, 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x, y)?;
+        chart
+            .configure_mesh()
+            .x_desc(x_desc)
+            .y_desc(y_desc)
+            .axis_desc_style((FONT, 15))
+            .label_style((FONT, 13))
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()?;
+        if points.is_empty() {
+            let (w, h) = root.dim_in_pixel();
+            root.draw_text(
+                "no run was extrapolated",
+                &TextStyle::from((FONT, 18).into_font()).color(&GREY),
+                (w as i32 / 3, h as i32 / 2),
+            )?;
+        }
+        chart.draw_series(points.iter().map(|(x, y, label)| {
+            EmptyElement::at((*x, *y))
+                + Circle::new((0, 0), 5, HOT.filled())
+                + Text::new(label.clone(), (7, -16), (FONT, 13).into_font())
+        }))?;
+        root.present()?;
+    }
+    Ok(svg)
+}
+
+/// One series of group means over time.
+pub struct Series {
+    pub label: String,
+    /// `(t, hot, cold)`.
+    pub points: Vec<(f64, f64, f64)>,
+    /// The DEM (solid line) or an extrapolation (markers).
+    pub dem: bool,
+}
+
+/// Figures 13–15: hot and cold group means over time, the DEM as lines and each
+/// extrapolation as markers (one shape per series).
+pub fn means(title: &str, series: &[Series]) -> Result<String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
+        root.fill(&WHITE)?;
+        let all = || series.iter().flat_map(|s| s.points.iter());
+        let x = span(all().map(|p| p.0), 0.03);
+        let y = span(all().flat_map(|p| [p.1, p.2]), 0.08);
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FONT, 20))
+            .margin(12)
+            .x_label_area_size(48)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x, y)?;
+        chart
+            .configure_mesh()
+            .x_desc("t (s)")
+            .y_desc("group mean temperature (K)")
+            .axis_desc_style((FONT, 15))
+            .label_style((FONT, 13))
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .light_line_style(RGBColor(235, 235, 235))
+            .draw()?;
+        let mut marker = 0;
+        for s in series {
+            if s.dem {
+                for (colour, pick) in [(HOT, 1usize), (COLD, 2)] {
+                    let pts = s
+                        .points
+                        .iter()
+                        .map(|p| (p.0, if pick == 1 { p.1 } else { p.2 }));
+                    chart.draw_series(LineSeries::new(pts, colour.stroke_width(2)))?;
+                }
+                chart
+                    .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())?
+                    .label(s.label.clone())
+                    .legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2))
+                    });
+            } else {
+                let m = marker;
+                marker += 1;
+                let shape = move |c: (f64, f64),
+                                  colour: RGBColor|
+                      -> DynElement<'static, SVGBackend, (f64, f64)> {
+                    match m % 3 {
+                        0 => Circle::new(c, 5, colour.filled()).into_dyn(),
+                        1 => TriangleMarker::new(c, 6, colour.filled()).into_dyn(),
+                        _ => Cross::new(c, 5, colour.stroke_width(2)).into_dyn(),
+                    }
+                };
+                chart.draw_series(s.points.iter().map(|p| shape((p.0, p.1), HOT)))?;
+                chart
+                    .draw_series(s.points.iter().map(|p| shape((p.0, p.2), COLD)))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| match m % 3 {
+                        0 => Circle::new((x + 10, y), 5, GREY.filled()).into_dyn(),
+                        1 => TriangleMarker::new((x + 10, y), 6, GREY.filled()).into_dyn(),
+                        _ => Cross::new((x + 10, y), 5, GREY.stroke_width(2)).into_dyn(),
+                    });
+            }
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(GREY)
+            .label_font((FONT, 13))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        root.present()?;
+    }
+    Ok(svg)
+}

@@ -1,0 +1,324 @@
+//! `tdex study` end to end on the tiny drum (short periods: τ = 0.05 revolution = 0.1 s):
+//! the sampling grid from one DEM run (and its tables equal `tdex record`'s), the period
+//! study, the regime study's refusal at a centrifuging speed, and bad flags.
+
+use crate::cli_run::TINY_CASE;
+use crate::util::*;
+use recorder::format::RecordingReader;
+use std::path::{Path, PathBuf};
+
+fn write_case(dir: &Path) -> PathBuf {
+    let case = dir.join("tiny.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    case
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = run_tdex(args);
+    assert!(
+        o.status.success(),
+        "tdex {args:?} failed: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// All rows of a recording's table, as `(i, j, start, duration, sqrt_area)`.
+fn rows(path: &Path) -> Vec<(u32, u32, u64, u32, f64)> {
+    let r = RecordingReader::open(path).unwrap();
+    r.table()
+        .flat_map(|b| b.unwrap().rows)
+        .map(|x| (x.i, x.j, x.start_step, x.duration_steps, x.sqrt_area))
+        .collect()
+}
+
+#[test]
+fn sampling_grid_skips_non_multiples_and_matches_tdex_record() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path());
+    let out = dir.path().join("sampling");
+    let common = [
+        "study",
+        "sampling",
+        case.to_str().unwrap(),
+        "--n",
+        "5,10,20",
+        "--dtc-max",
+        "10,20,100",
+        "--tau-rev",
+        "0.05",
+        "--periods",
+        "2",
+        "--threads",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    // the terminal form names the skipped combination
+    let text = ok(&common);
+    assert!(
+        text.contains("n = 20, Δt_c^max = 10: skipped (not a multiple of n)"),
+        "{text}"
+    );
+    for f in [
+        "study.md",
+        "study.json",
+        "error_vs_table_size.svg",
+        "error_vs_speedup.svg",
+    ] {
+        assert!(out.join(f).is_file(), "missing {f}");
+    }
+    let svg = std::fs::read_to_string(out.join("error_vs_speedup.svg")).unwrap();
+    roxmltree::Document::parse(&svg).expect("well-formed SVG");
+
+    let mut args = common.to_vec();
+    args.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&ok(&args)).expect("one JSON object");
+    assert_eq!(v["one_dem_run"], true);
+    assert_eq!(v["periods"], 2);
+    assert_eq!(v["skipped"].as_array().unwrap().len(), 1);
+    assert_eq!(v["skipped"][0]["n"], 20);
+    assert_eq!(v["skipped"][0]["dtc_max_steps"], 10);
+    let grid = v["grid"].as_array().unwrap();
+    assert_eq!(grid.len(), 8, "3 × 3 combinations, one skipped");
+    let get = |n: u64, d: u64| {
+        grid.iter()
+            .find(|e| e["n"] == n && e["dtc_max_steps"] == d)
+            .unwrap_or_else(|| panic!("no entry n = {n}, dtc_max = {d}"))
+    };
+    for e in grid {
+        for key in [
+            "rows",
+            "table_bytes",
+            "bytes_per_row",
+            "replay_seconds_per_period",
+            "eps_rel",
+            "eps_rel_max",
+            "energy_error",
+            "energy_error_mean_abs",
+            "speedup_100",
+        ] {
+            assert!(e.get(key).is_some(), "missing {key} in {e}");
+        }
+        assert!(e["error"].is_null(), "{e}");
+        assert!(e["bytes_per_row"].as_f64().unwrap() > 0.0);
+        assert_eq!(e["eps_rel"].as_array().unwrap().len(), 2);
+        let max = e["eps_rel"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .fold(0.0, f64::max);
+        assert_eq!(e["eps_rel_max"].as_f64().unwrap(), max);
+    }
+    // rows fall as n grows (same Δt_c^max) and as Δt_c^max grows (same n)
+    for d in [20, 100] {
+        let r: Vec<u64> = [5, 10, 20]
+            .iter()
+            .map(|&n| get(n, d)["rows"].as_u64().unwrap())
+            .collect();
+        assert!(r[0] >= r[1] && r[1] >= r[2], "Δt_c^max = {d}: rows {r:?}");
+        assert!(r[0] > r[2], "Δt_c^max = {d}: rows {r:?}");
+    }
+    for n in [5, 10] {
+        let r: Vec<u64> = [10, 20, 100]
+            .iter()
+            .map(|&d| get(n, d)["rows"].as_u64().unwrap())
+            .collect();
+        assert!(r[0] > r[1] && r[1] > r[2], "n = {n}: rows {r:?}");
+    }
+
+    // one DEM run for all samplers: the same table and snapshots as `tdex record` alone
+    let solo = dir.path().join("solo.mcap");
+    ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        solo.to_str().unwrap(),
+        "--tau-rev",
+        "0.05",
+        "--n",
+        "10",
+        "--dtc-max",
+        "20",
+        "--reference",
+        "2",
+        "--threads",
+        "2",
+        "--json",
+    ]);
+    let shared = out.join("n10_dtc20.mcap");
+    assert_eq!(rows(&solo), rows(&shared));
+    let (a, b) = (
+        RecordingReader::open(&solo).unwrap(),
+        RecordingReader::open(&shared).unwrap(),
+    );
+    assert_eq!(a.snapshots().unwrap(), b.snapshots().unwrap());
+    assert_eq!(a.table_bytes(), b.table_bytes());
+    assert_eq!(
+        get(10, 20)["table_bytes"].as_u64().unwrap(),
+        a.table_bytes()
+    );
+}
+
+#[test]
+fn period_study_covers_the_same_time_per_tau() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path());
+    let out = dir.path().join("period");
+    let v: serde_json::Value = serde_json::from_str(&ok(&[
+        "study",
+        "period",
+        case.to_str().unwrap(),
+        "--tau-rev",
+        "0.025,0.05",
+        "--revolutions",
+        "0.1",
+        "--threads",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+        "--json",
+    ]))
+    .unwrap();
+    let runs = v["runs"].as_array().unwrap();
+    assert_eq!(runs.len(), 2);
+    assert_eq!(runs[0]["periods"], 4);
+    assert_eq!(runs[1]["periods"], 2);
+    for r in runs {
+        assert!(r["error"].is_null(), "{r}");
+        assert!(r["eps_rel_max"].as_f64().is_some());
+        // both reach the same simulated time: t1 + 0.1 rev (the drum turns in 2 s)
+        let last = r["k"].as_array().unwrap().last().unwrap().as_u64().unwrap();
+        assert_eq!(last, r["periods"].as_u64().unwrap() + 1);
+    }
+    assert!(out.join("means.svg").is_file() && out.join("study.md").is_file());
+}
+
+#[test]
+fn regimes_refuse_to_extrapolate_a_centrifuging_drum() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path());
+    let out = dir.path().join("regimes");
+    let args = [
+        "study",
+        "regimes",
+        case.to_str().unwrap(),
+        "--rev-period",
+        "2,0.2",
+        "--tau-rev",
+        "0.05",
+        "--periods",
+        "1",
+        "--threads",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    let text = ok(&args);
+    assert!(
+        text.contains("0.2 s per revolution (ω = 31.416 rad/s, Froude 5.030): extrapolation refused: the drum centrifuges"),
+        "{text}"
+    );
+    assert!(
+        text.contains("the method has nothing to extrapolate"),
+        "{text}"
+    );
+    let mut json_args = args.to_vec();
+    json_args.push("--json");
+    let v: serde_json::Value = serde_json::from_str(&ok(&json_args)).unwrap();
+    let runs = v["runs"].as_array().unwrap();
+    // R = 0.05 m: 2 s/rev → Fr = 0.0503 (cascading), 0.2 s/rev → Fr = 5.03 (centrifuging)
+    assert_eq!(runs[0]["regime"], "cascading");
+    assert!((runs[0]["froude"].as_f64().unwrap() - 0.05030).abs() < 1e-4);
+    assert_eq!(runs[0]["extrapolated"], true);
+    assert!(runs[0]["refusal"].is_null());
+    assert!(runs[0]["outcome"]["eps_rel_max"].as_f64().is_some());
+    let a = runs[0]["angle_degrees"].as_f64().unwrap();
+    assert!(a > 0.0 && a < 90.0, "angle {a}");
+    assert_eq!(runs[1]["regime"], "centrifuging");
+    assert_eq!(runs[1]["extrapolated"], false);
+    assert!(runs[1]["outcome"].is_null());
+    assert!(runs[1]["refusal"]
+        .as_str()
+        .unwrap()
+        .contains("Fr = ω²R/g ≥ 1"));
+    // still measured at that speed
+    assert!(runs[1]["relative_speed"].as_f64().is_some());
+}
+
+#[test]
+fn bad_study_flags_exit_2_naming_the_flag() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path());
+    let c = case.to_str().unwrap();
+    let o = dir.path().join("out");
+    let o = o.to_str().unwrap();
+    let cases: &[(&[&str], &str)] = &[
+        (&["sampling", c, "--n", "0", "-o", o], "--n = 0"),
+        (&["sampling", c, "--n", "", "-o", o], "--n is empty"),
+        (&["sampling", c, "--n", "5,,10", "-o", o], "--n"),
+        (
+            &["sampling", c, "--dtc-max", "-5", "-o", o],
+            "--dtc-max = -5",
+        ),
+        (&["sampling", c, "--n", "x", "-o", o], "\"x\" is not"),
+        (&["sampling", c, "--periods", "0", "-o", o], "--periods = 0"),
+        (
+            &["sampling", c, "--n", "20", "--dtc-max", "10,30", "-o", o],
+            "nothing to run",
+        ),
+        (&["sampling", c, "--tau-rev", "0", "-o", o], "--tau-rev = 0"),
+        (
+            &["sampling", c, "--tau-rev", "-1", "-o", o],
+            "--tau-rev = -1",
+        ),
+        (
+            &["regimes", c, "--min-relative", "-1", "-o", o],
+            "--min-relative = -1",
+        ),
+        (
+            &["period", c, "--tau-rev", "0.5,-1", "-o", o],
+            "--tau-rev = -1",
+        ),
+        (
+            &[
+                "period",
+                c,
+                "--tau-rev",
+                "0.4",
+                "--revolutions",
+                "1",
+                "-o",
+                o,
+            ],
+            "whole number",
+        ),
+        (
+            &["period", c, "--revolutions", "0", "-o", o],
+            "--revolutions = 0",
+        ),
+        (
+            &["regimes", c, "--rev-period", "abc", "-o", o],
+            "--rev-period",
+        ),
+        (
+            &["regimes", c, "--rev-period", "0", "-o", o],
+            "--rev-period = 0",
+        ),
+        (&["regimes", c, "--cells", "0", "-o", o], "--cells = 0"),
+        (&["regimes", c, "--threads", "0", "-o", o], "--threads = 0"),
+    ];
+    for (args, expected) in cases {
+        let mut all = vec!["study"];
+        all.extend_from_slice(args);
+        let out = run_tdex(&all);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{all:?}: {stderr}");
+        assert!(stderr.contains(expected), "{all:?}: {stderr}");
+    }
+    assert!(
+        !Path::new(o).exists(),
+        "no work before the flags are checked"
+    );
+}
