@@ -12,7 +12,7 @@ use std::time::Instant;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
 #[derive(Debug, Serialize)]
-struct ExtrapolationReport {
+pub struct ExtrapolationReport {
     output: String,
     scheme: String,
     periods: u32,
@@ -27,10 +27,13 @@ struct ExtrapolationReport {
 }
 
 pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
-    crate::with_workers(plan.threads, || extrapolate(plan))
+    let report = crate::with_workers(plan.threads, || extrapolate(plan))?;
+    print(&report, plan.json)
 }
 
-fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
+/// Pairs (or reuses the stored pairing), replays and writes the extrapolation; prints
+/// nothing. Runs on the current worker pool.
+pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
     let reader = RecordingReader::open(&plan.file)?;
     let info = reader.info().clone();
     let (t0, t1) = pair::period_snapshots(&reader)?;
@@ -147,8 +150,12 @@ fn extrapolate(plan: &ExtrapolatePlan) -> Result<()> {
         total_heat_t1: heat_t1,
         total_heat_end: replay::total_heat(&temps, &bodies),
     };
-    if plan.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+    Ok(report)
+}
+
+fn print(report: &ExtrapolationReport, json: bool) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(report)?);
     } else {
         let c = &report.costs;
         println!(

@@ -1,6 +1,5 @@
 //! `tdex study`: parameter studies over recordings (Haydar §3.2–3.3). Each run is recorded,
-//! extrapolated (by `tdex extrapolate` in a child process, so its own output stays out of
-//! the study's) and compared in-process with the DEM reference; the study writes a grid on
+//! extrapolated and compared with the DEM reference; the study writes a grid on
 //! the terminal (or JSON), `study.json`, `study.md` and SVG plots into its directory.
 
 pub mod flow;
@@ -9,9 +8,11 @@ mod plots;
 mod regimes;
 mod sampling;
 
-use crate::cli::{StudyKind, StudyPlan};
+use crate::cli::{ExtrapolatePlan, StudyKind, StudyPlan};
 use crate::compare::{self, Comparison};
+use crate::extrapolation;
 use anyhow::{Context, Result};
+use extrapolate::replay::Scheme;
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -148,31 +149,18 @@ pub fn evaluate(
     cells: usize,
 ) -> Result<Outcome> {
     let rec = RecordingReader::open(recording)?;
-    let exe = std::env::current_exe().context("cannot find the tdex executable")?;
-    let out = std::process::Command::new(exe)
-        .arg("extrapolate")
-        .arg(recording)
-        .args([
-            "--periods",
-            &periods.to_string(),
-            "--threads",
-            &threads.to_string(),
-        ])
-        .arg("-o")
-        .arg(extra)
-        .arg("--json")
-        .output()
-        .context("cannot start `tdex extrapolate`")?;
-    if !out.status.success() {
-        let stderr = String::from_utf8_lossy(&out.stderr);
-        let message = stderr
-            .lines()
-            .rev()
-            .find(|l| !l.trim().is_empty())
-            .unwrap_or("tdex extrapolate failed")
-            .trim_start_matches("error: ")
-            .to_string();
-        return Ok(Outcome::table_only(&rec, message));
+    let plan = ExtrapolatePlan {
+        file: recording.to_path_buf(),
+        periods,
+        output: extra.to_path_buf(),
+        scheme: Scheme::Explicit,
+        stream: false,
+        threads,
+        json: true,
+    };
+    if let Err(e) = crate::with_workers(threads, || extrapolation::extrapolate(&plan)) {
+        // a refused extrapolation (e.g. the explicit scheme's CFL guard) is a study result
+        return Ok(Outcome::table_only(&rec, format!("{e:#}")));
     }
     let ext = ExtrapolationReader::open(extra)?;
     let c = compare::compare(&rec, &ext, cells, compare::DEFAULT_SEED)?;
