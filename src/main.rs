@@ -8,6 +8,7 @@ mod demo;
 mod extrapolation;
 mod inspect;
 mod pair;
+mod progress;
 mod record;
 mod report;
 mod run;

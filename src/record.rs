@@ -3,9 +3,8 @@
 use crate::cli::RecordPlan;
 use crate::inspect::Sampling;
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use recorder::format::RecordingReader;
-use recorder::record::{self, Phase};
+use recorder::record;
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -30,31 +29,8 @@ struct RecordReport {
 }
 
 pub fn run(plan: &RecordPlan) -> Result<()> {
-    let bar = if plan.json {
-        ProgressBar::hidden()
-    } else {
-        let bar = ProgressBar::new(1);
-        bar.set_style(
-            ProgressStyle::with_template("{msg:>9} [{bar:40}] {pos}/{len} steps ({eta} left)")
-                .expect("static template")
-                .progress_chars("=> "),
-        );
-        bar
-    };
-    let mut progress = |phase: Phase, done: u64, total: u64| {
-        let name = match phase {
-            Phase::Settle => "settle",
-            Phase::SpinUp => "spin-up",
-            Phase::Period => "record",
-            Phase::Reference => "reference",
-        };
-        if bar.message() != name {
-            bar.set_message(name);
-            bar.set_length(total);
-            bar.reset_eta();
-        }
-        bar.set_position(done);
-    };
+    let bar = crate::progress::dem_bar(plan.json, "");
+    let mut progress = crate::progress::on_phase(&bar);
     crate::with_workers(plan.threads, || {
         Ok(record::record(
             &plan.case,

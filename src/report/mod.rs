@@ -5,7 +5,7 @@
 mod content;
 pub(crate) mod costs;
 mod document;
-mod plots;
+pub(crate) mod plots;
 
 use crate::cli::ReportPlan;
 use crate::compare::{self, Comparison};
@@ -166,7 +166,7 @@ pub fn write(
 }
 
 /// Writes `dir/name` through a temporary file in `dir` renamed into place.
-fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
+pub(crate) fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
     let dest = dir.join(name);
     let partial = dir.join(format!(".{name}.partial-{}", std::process::id()));
     let result = std::fs::File::create(&partial)

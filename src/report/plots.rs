@@ -35,7 +35,7 @@ fn render(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<St
 }
 
 /// A padded axis range over the finite `values` (and `include`); never empty.
-fn span(values: impl IntoIterator<Item = f64>, include: &[f64], pad: f64) -> Range<f64> {
+pub(crate) fn span(values: impl IntoIterator<Item = f64>, include: &[f64], pad: f64) -> Range<f64> {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for v in values.into_iter().chain(include.iter().copied()) {
         if v.is_finite() {
@@ -55,7 +55,7 @@ fn span(values: impl IntoIterator<Item = f64>, include: &[f64], pad: f64) -> Ran
 }
 
 /// Tick labels without trailing zeros: `2`, `0.25`, `1.5e-5`.
-fn tick(v: f64) -> String {
+pub(crate) fn tick(v: f64) -> String {
     if v == 0.0 {
         return "0".into();
     }

@@ -15,9 +15,7 @@ use anyhow::{Context, Result};
 use extrapolate::replay::Scheme;
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
-use indicatif::{ProgressBar, ProgressStyle};
 use recorder::format::{ExtrapolationReader, RecordingReader};
-use recorder::record::Phase;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -39,55 +37,7 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
     }
 }
 
-/// A progress bar on stderr for the DEM phases (hidden with `--json`).
-pub(crate) fn dem_bar(hidden: bool, label: &str) -> ProgressBar {
-    if hidden {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(1);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{label} {{msg:>9}} [{{bar:40}}] {{pos}}/{{len}} steps ({{eta}} left)"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar
-}
-
-/// The progress callback of the recorder, drawing on `bar`.
-pub(crate) fn on_phase(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
-    move |phase, done, total| {
-        let name = match phase {
-            Phase::Settle => "settle",
-            Phase::SpinUp => "spin-up",
-            Phase::Period => "record",
-            Phase::Reference => "reference",
-        };
-        if bar.message() != name {
-            bar.set_message(name);
-            bar.set_length(total);
-            bar.reset_eta();
-        }
-        bar.set_position(done);
-    }
-}
-
-/// A bar over the runs of a stage (extrapolate + compare), hidden with `--json`.
-pub(crate) fn runs_bar(hidden: bool, total: usize, what: &str) -> ProgressBar {
-    if hidden {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{what} [{{bar:40}}] {{pos}}/{{len}} runs ({{elapsed}}) {{msg}}"
-        ))
-        .expect("static template")
-        .progress_chars("=> "),
-    );
-    bar
-}
+pub(crate) use crate::progress::{dem_bar, on_phase, runs_bar};
 
 /// The errors and costs of one recording extrapolated against its DEM reference.
 #[derive(Debug, Clone, Serialize)]
@@ -193,14 +143,21 @@ pub(crate) fn num(x: Option<f64>, digits: usize) -> String {
     x.map_or("-".into(), |v| format!("{v:.digits$}"))
 }
 
+/// Prints the study: its JSON, or the table and the files written.
+pub(crate) fn print_outcome(json: bool, json_text: &str, table: &str, files: &[PathBuf]) {
+    if json {
+        println!("{json_text}");
+    } else {
+        print!("{table}");
+        for f in files {
+            println!("wrote         {}", f.display());
+        }
+    }
+}
+
 /// Writes `dir/name` (through a temporary file renamed into place); returns its path.
 pub(crate) fn write_file(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
-    let dest = dir.join(name);
-    let partial = dir.join(format!(".{name}.partial-{}", std::process::id()));
-    std::fs::write(&partial, text)
-        .and_then(|()| std::fs::rename(&partial, &dest))
-        .with_context(|| format!("{}: cannot write", dest.display()))?;
-    Ok(dest)
+    crate::report::write_atomically(dir, name, text.as_bytes())
 }
 
 /// The paths of one run's files in the study directory.

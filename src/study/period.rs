@@ -154,14 +154,7 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
         &plots::means("Hot and cold group means per pairing period", &series)?,
     )?);
     files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    if plan.json {
-        println!("{json}");
-    } else {
-        print!("{table}");
-        for f in files {
-            println!("wrote         {}", f.display());
-        }
-    }
+    super::print_outcome(plan.json, &json, &table, &files);
     Ok(())
 }
 

@@ -1,45 +1,16 @@
 //! The study's SVG plots, in the report's style (plotters' SVG backend, text as SVG
-//! `<text>`, 820×520, sans-serif; the same inputs give the same bytes). The report's own
-//! drawing helpers are private to `src/report/plots.rs`, so the few needed here are below.
+//! `<text>`, 820×520, sans-serif; the same inputs give the same bytes), with its axis
+//! helpers.
 
+use crate::report::plots::{span, tick};
 use anyhow::Result;
 use plotters::prelude::*;
-use std::ops::Range;
 
 const FONT: &str = "sans-serif";
 const SIZE: (u32, u32) = (820, 520);
 const HOT: RGBColor = RGBColor(200, 35, 35);
 const COLD: RGBColor = RGBColor(35, 80, 200);
 const GREY: RGBColor = RGBColor(120, 120, 120);
-
-/// A padded range over the finite values; never empty.
-fn span(values: impl IntoIterator<Item = f64>, pad: f64) -> Range<f64> {
-    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-    for v in values.into_iter().filter(|v| v.is_finite()) {
-        lo = lo.min(v);
-        hi = hi.max(v);
-    }
-    if lo > hi {
-        return 0.0..1.0;
-    }
-    if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(1e-300) {
-        let d = if lo == 0.0 { 1.0 } else { 0.05 * lo.abs() };
-        return lo - d..hi + d;
-    }
-    let d = pad * (hi - lo);
-    lo - d..hi + d
-}
-
-fn tick(v: f64) -> String {
-    if v == 0.0 {
-        return "0".into();
-    }
-    if !(1e-3..1e6).contains(&v.abs()) {
-        return format!("{v:.1e}");
-    }
-    let s = format!("{v:.4}");
-    s.trim_end_matches('0').trim_end_matches('.').to_string()
-}
 
 /// Labelled points `(x, y, label)`; a message instead when there are none.
 pub fn scatter(
@@ -52,8 +23,8 @@ pub fn scatter(
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE)?;
-        let x = span(points.iter().map(|p| p.0), 0.12);
-        let y = span(points.iter().map(|p| p.1).chain([0.0]), 0.12);
+        let x = span(points.iter().map(|p| p.0), &[], 0.12);
+        let y = span(points.iter().map(|p| p.1), &[0.0], 0.12);
         let mut chart = ChartBuilder::on(&root)
             .caption(title, (FONT, 20))
             .margin(12)
@@ -105,8 +76,8 @@ pub fn means(title: &str, series: &[Series]) -> Result<String> {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
         root.fill(&WHITE)?;
         let all = || series.iter().flat_map(|s| s.points.iter());
-        let x = span(all().map(|p| p.0), 0.03);
-        let y = span(all().flat_map(|p| [p.1, p.2]), 0.08);
+        let x = span(all().map(|p| p.0), &[], 0.03);
+        let y = span(all().flat_map(|p| [p.1, p.2]), &[], 0.08);
         let mut chart = ChartBuilder::on(&root)
             .caption(title, (FONT, 20))
             .margin(12)

@@ -193,14 +193,7 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
         )?,
     )?);
     files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    if plan.json {
-        println!("{json}");
-    } else {
-        print!("{table}");
-        for f in files {
-            println!("wrote         {}", f.display());
-        }
-    }
+    super::print_outcome(plan.json, &json, &table, &files);
     Ok(())
 }
 

@@ -191,14 +191,7 @@ pub fn run(
         )?,
     )?);
     files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    if plan.json {
-        println!("{json}");
-    } else {
-        print!("{table}");
-        for f in files {
-            println!("wrote         {}", f.display());
-        }
-    }
+    super::print_outcome(plan.json, &json, &table, &files);
     Ok(())
 }
 
