@@ -5,6 +5,13 @@
 //! particles: `TDEX_N`, default 80000, the drum length scaled to keep the fill; initial
 //! k: `TDEX_K`, default the library's).
 //!
+//! Real recordings: `TDEX_RECORDING=/path.mcap` pairs the recording's t0 and t1
+//! snapshots instead (diameter: the mean of t0's), `TDEX_TILE=m` (default 1) first tiles
+//! the bed m times along the drum axis (y), each copy shifted by the bed's y extent plus
+//! one diameter, so that 4 × 20 000 gives an 80 000 instance with the structure of real
+//! data. `TDEX_REPEAT` (default 3) runs, certified, 2 threads (`TDEX_THREADS`); all runs
+//! must give the same result, which `TDEX_DUMP_G=file` writes out (g, one index a line).
+//!
 //! Two t1 snapshots against the same t0 packing:
 //! * `independent`: a second packing of the same region generated independently (other
 //!   lattice orientation and offset, other jitter): no correlation at all, the worst case;
@@ -45,25 +52,115 @@ fn spacing_for_fill(drum: &Drum, n: usize, fill: f64) -> f64 {
 }
 
 fn report(name: &str, r: &Pairing) {
+    report_d(name, r, D);
+}
+
+fn report_d(name: &str, r: &Pairing, d: f64) {
     println!(
         "{name:12} n {:6} | k {:3} rounds {:2} certified {:5} | total cost {:13} | mean {:.4} d | \
-         edges {:8} growth {:5} added {:6} cert. examined {:9} | {:.3} s",
+         edges {:8} growth {:5} added {:6} cert. examined {:9} bids {:9} | {:.3} s",
         r.g.len(),
         r.k_used,
         r.rounds,
         r.certified,
         r.total_cost,
-        r.mean_distance_in_diameters(D),
+        r.mean_distance_in_diameters(d),
         r.edges,
         r.growth_pairs,
         r.added_pairs,
         r.certificate_examined,
+        r.auction_bids,
         r.seconds
     );
 }
 
+/// The t0/t1 snapshots of a recording, tiled `tile` times along y; also the diameter.
+fn load_recording(path: &str, tile: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, f64) {
+    let reader = recorder::format::RecordingReader::open(std::path::Path::new(path)).unwrap();
+    let s0 = reader.snapshot(0).unwrap().expect("no t0 snapshot");
+    let s1 = reader.snapshot(1).unwrap().expect("no t1 snapshot");
+    let d = 2.0 * s0.radius.iter().sum::<f64>() / s0.radius.len() as f64;
+    let (mut ylo, mut yhi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for p in s0.pos.iter().chain(&s1.pos) {
+        ylo = ylo.min(p[1]);
+        yhi = yhi.max(p[1]);
+    }
+    let shift = yhi - ylo + d;
+    for (name, s) in [("t0", &s0), ("t1", &s1)] {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in &s.pos {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        println!(
+            "{name}: {} particles, box {lo:.4?} .. {hi:.4?} m",
+            s.pos.len()
+        );
+    }
+    let tiled = |pos: &[[f64; 3]]| -> Vec<[f64; 3]> {
+        (0..tile)
+            .flat_map(|m| {
+                pos.iter()
+                    .map(move |p| [p[0], p[1] + m as f64 * shift, p[2]])
+            })
+            .collect()
+    };
+    (tiled(&s0.pos), tiled(&s1.pos), d)
+}
+
+fn recording(path: &str, threads: usize) {
+    let tile = env_usize("TDEX_TILE", 1);
+    let repeat = env_usize("TDEX_REPEAT", 3);
+    let t = Instant::now();
+    let (x0, x1, d) = load_recording(path, tile);
+    println!(
+        "recording {path}: {} particles ({tile} × {}), d = {d:.6} m, read in {:.2} s; \
+         {threads} threads",
+        x0.len(),
+        x0.len() / tile,
+        t.elapsed().as_secs_f64()
+    );
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let defaults = PairingOptions::for_diameter(d);
+    let opts = PairingOptions {
+        k_initial: env_usize("TDEX_K", defaults.k_initial),
+        ..defaults
+    };
+    let mut first: Option<Pairing> = None;
+    let mut times = Vec::new();
+    for i in 0..repeat {
+        let r = pool.install(|| pair(&x0, &x1, &opts)).unwrap();
+        assert!(is_permutation(&r.g));
+        report_d(&format!("real/{tile}x#{i}"), &r, d);
+        times.push(r.seconds);
+        if let Some(f) = &first {
+            assert_eq!(f.g, r.g, "runs differ");
+        } else {
+            // `TDEX_DUMP_G=file`: write g, one index a line, to compare two builds.
+            if let Ok(path) = std::env::var("TDEX_DUMP_G") {
+                let text: String = r.g.iter().map(|q| format!("{q}\n")).collect();
+                std::fs::write(path, text).unwrap();
+            }
+            first = Some(r);
+        }
+    }
+    let min = times.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = times.iter().copied().fold(0.0, f64::max);
+    println!("min {min:.3} s, range {min:.3}–{max:.3} s over {repeat} runs");
+}
+
 fn main() {
     let threads = env_usize("TDEX_THREADS", 2);
+    if let Ok(path) = std::env::var("TDEX_RECORDING") {
+        recording(&path, threads);
+        return;
+    }
     let n = env_usize("TDEX_N", 80_000);
     // The paper's drum holds 80 000 at 35 %; other n keep the fill by scaling the length.
     let drum = Drum {

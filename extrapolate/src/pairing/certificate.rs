@@ -100,22 +100,24 @@ impl WeightedTree {
         }
     }
 
-    /// Calls `visit(tree position)` for every point not excluded by the bound
-    /// `mindist(p, box) + W_min < r`, and for each of those points whose own
-    /// `d + W < r`. Returns nothing; `stack` is scratch.
+    /// Calls `visit(tree position)` for every point with `d + W < r`, skipping every
+    /// node with `mindist(p, box) + W_min >= r`. `stack` is scratch. Both tests are
+    /// made on squares (`d < r − W` with `r − W > 0`), without square roots; the
+    /// rounding of either form is far below the margin built into `r`.
     fn search(&self, p: &[f64; 3], r: f64, stack: &mut Vec<u32>, mut visit: impl FnMut(usize)) {
         stack.clear();
         stack.push(0);
         while let Some(i) = stack.pop() {
             let i = i as usize;
             let nd = &self.nodes[i];
-            if mindist(p, &nd.lo, &nd.hi) + self.wmin[i] >= r {
+            let reach = r - self.wmin[i];
+            if reach <= 0.0 || mindist2(p, &nd.lo, &nd.hi) >= reach * reach {
                 continue;
             }
             if nd.left == 0 {
                 for t in nd.start as usize..nd.end as usize {
-                    let d = super::cost::distance(p, &self.pts[t]);
-                    if d + self.w[t] < r {
+                    let reach = r - self.w[t];
+                    if reach > 0.0 && dist2(p, &self.pts[t]) < reach * reach {
                         visit(t);
                     }
                 }
@@ -165,15 +167,22 @@ fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>)
     me as u32
 }
 
-/// Distance from `p` to the box `[lo, hi]` (0 inside).
+/// Squared distance from `p` to the box `[lo, hi]` (0 inside).
 #[inline]
-fn mindist(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
+fn mindist2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
     let mut s = 0.0;
     for a in 0..3 {
         let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
         s += d * d;
     }
-    s.sqrt()
+    s
+}
+
+/// Squared distance between two points.
+#[inline]
+fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    dx * dx + dy * dy + dz * dz
 }
 
 /// Outcome of one certificate pass.
@@ -184,27 +193,63 @@ pub(crate) struct Check {
     pub(crate) examined: u64,
 }
 
+/// What the previous passes proved, so that a pass only re-examines the rows where a
+/// violation can have appeared since.
+///
+/// A pass proves, for every row `p` it examines, `c(p, q) >= u[p] + v[q]` for every
+/// column `q` it does not return (unless it returned more than
+/// [`MAX_ADDED_PER_ROW`]: then the row is examined again next time). The returned
+/// pairs join the candidate graph, where the solver keeps them non-violating. The pair
+/// inequality can only break again if `u[p] + v[q]` grows. Column potentials never
+/// increase in this solver (augmentations and auction bids only lower them; this is
+/// checked, and a full pass is made if it ever fails), so a row needs examining again
+/// only if its own `u[p]` grew since its last examination.
+#[derive(Default)]
+pub(crate) struct Memo {
+    /// `u[p]` when row `p` was last examined (`i64::MIN`: never).
+    u: Vec<i64>,
+    /// `v[q]` at the last pass.
+    v: Vec<i64>,
+    /// Row returned more than `MAX_ADDED_PER_ROW` violations: examine again.
+    again: Vec<bool>,
+}
+
 /// One certificate pass (in parallel over rows, results collected in row order).
 /// `lap` must hold a perfect matching that satisfies the invariant on the current
-/// candidate graph.
+/// candidate graph. `memo` carries what earlier passes proved (start with
+/// `Memo::default()`); rows that cannot have gained a violation since are skipped.
 pub(crate) fn check(
     tree: &mut WeightedTree,
     x1: &[[f64; 3]],
     lap: &Lap,
     scale: &CostScale,
+    memo: &mut Memo,
 ) -> Check {
-    let v_max = (0..x1.len()).map(|q| lap.v(q)).max().unwrap_or(0);
+    let n = x1.len();
+    let v_now: Vec<i64> = (0..n).map(|q| lap.v(q)).collect();
+    // The skip rule needs every column potential to be at most what it was at the
+    // previous pass; otherwise forget everything and examine all rows.
+    if memo.v.len() != n || memo.v.iter().zip(&v_now).any(|(old, new)| new > old) {
+        memo.u = vec![i64::MIN; n];
+        memo.again = vec![true; n];
+    }
+    memo.v = v_now;
+    let v_max = memo.v.iter().copied().max().unwrap_or(0);
     let unit = scale.unit();
     tree.set_weights(|q| lap.v(q), v_max, unit);
     let tree = &*tree;
-    let per_row: Vec<(Vec<u32>, u64)> = (0..x1.len())
+    let (memo_u, memo_again) = (&memo.u, &memo.again);
+    let per_row: Vec<(Vec<u32>, u64, bool)> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map_init(Vec::new, |stack, p| {
             let u = lap.u(p);
+            if !memo_again[p] && u <= memo_u[p] {
+                return (Vec::new(), 0, false); // proven at an earlier pass, still holds
+            }
             if u + v_max <= 0 {
                 // c >= 0 and v <= v_max: nothing can undercut.
-                return (Vec::new(), 0);
+                return (Vec::new(), 0, false);
             }
             let r = ((u + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
             let mut bad: Vec<(i64, u32)> = Vec::new();
@@ -217,16 +262,21 @@ pub(crate) fn check(
                     bad.push((reduced, q as u32));
                 }
             });
+            let truncated = bad.len() > MAX_ADDED_PER_ROW;
             bad.sort_unstable();
             bad.truncate(MAX_ADDED_PER_ROW);
             let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
             cols.sort_unstable();
-            (cols, examined)
+            (cols, examined, truncated)
         })
         .collect();
     let mut violations = Vec::new();
     let mut examined = 0;
-    for (p, (bad, m)) in per_row.into_iter().enumerate() {
+    for (p, (bad, m, truncated)) in per_row.into_iter().enumerate() {
+        if memo.again[p] || lap.u(p) > memo.u[p] {
+            memo.u[p] = lap.u(p); // examined in this pass
+        }
+        memo.again[p] = truncated;
         examined += m;
         violations.extend(bad.into_iter().map(|q| (p as u32, q)));
     }

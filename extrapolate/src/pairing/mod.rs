@@ -7,12 +7,12 @@
 //! so the sparse solver and the dense oracle minimise exactly the same objective.
 //!
 //! * [`pair_dense`] — Kuhn–Munkres on the full matrix; the oracle, small n only.
-//! * [`pair`] — the solver for real beds: shortest augmenting paths (Jonker–Volgenant,
-//!   Dijkstra on reduced costs) on the k nearest t0 neighbours of each t1 point; exit
-//!   edges added on Hall-violating sets while the candidate graph has no perfect
-//!   matching; then an optimality certificate against every excluded pair, through the
-//!   dual potentials (pairs it finds are added and the solve repeated, warm-started,
-//!   until it holds).
+//! * [`pair`] — the solver for real beds: on the k nearest t0 neighbours of each t1
+//!   point, an ε-scaling auction as a warm start, then shortest augmenting paths
+//!   (Jonker–Volgenant, Dijkstra on reduced costs); exit edges added on
+//!   Hall-violating sets while the candidate graph has no perfect matching; then an
+//!   optimality certificate against every excluded pair, through the dual potentials
+//!   (pairs it finds are added and the solve repeated, warm-started, until it holds).
 //!
 //! Module map: `cost` (integer objective), `order` (Morton renumbering), `candidates`
 //! (kNN graph), `sparse_lap` (the solver), `feasibility` (Hopcroft–Karp, exit edges),
@@ -40,7 +40,9 @@ pub struct PairingOptions {
     /// costs small integers (≈ 6·10⁸ for the length of the paper's drum).
     pub unit: f64,
     /// Number of nearest t0 candidates per t1 point (≥ 1). If they admit no perfect
-    /// matching, exit edges are added on the Hall-violating sets (`growth_pairs`).
+    /// matching (detected when the auction warm start runs out of bids), k doubles
+    /// once; if that is still not enough, exit edges are added on the Hall-violating
+    /// sets (`growth_pairs`).
     pub k_initial: usize,
     /// Use the dense oracle when `n <= dense_max` (0: never). At most [`DENSE_LIMIT`].
     pub dense_max: usize,
@@ -51,12 +53,12 @@ pub struct PairingOptions {
 
 impl PairingOptions {
     /// Defaults for particles of the given diameter: `unit = diameter · 1e-6`,
-    /// `k_initial = 12`, never dense, certified.
+    /// `k_initial = 24`, never dense, certified.
     #[must_use]
     pub fn for_diameter(diameter: f64) -> Self {
         Self {
             unit: diameter * 1e-6,
-            k_initial: 12,
+            k_initial: 24,
             dense_max: 0,
             certify: true,
         }
@@ -73,8 +75,9 @@ pub struct Pairing {
     pub total_cost: i64,
     /// `Σ_p |x1[p] − x0[g[p]]|`, in the units of the coordinates (summed in row order).
     pub total_distance: f64,
-    /// Nearest t0 candidates per row in the kNN lists (`k_initial` capped at n); `n` for
-    /// the dense oracle. Growth adds individual edges, counted in `growth_pairs`.
+    /// Nearest t0 candidates per row in the kNN lists: `k_initial`, or twice that if
+    /// the first kNN graph had no perfect matching, capped at n; `n` for the dense
+    /// oracle. Growth adds individual edges, counted in `growth_pairs`.
     pub k_used: usize,
     /// True if the result is proven optimal for the complete problem (the dense oracle,
     /// or the sparse solver with its certificate).
@@ -90,6 +93,8 @@ pub struct Pairing {
     pub edges: usize,
     /// Points returned by the certificate's radius queries, all passes together.
     pub certificate_examined: u64,
+    /// Bids of the auction warm start (0 for the dense oracle).
+    pub auction_bids: u64,
     /// Wall-clock time of the call, in seconds.
     pub seconds: f64,
 }
@@ -210,6 +215,7 @@ pub fn pair_dense(x0: &[[f64; 3]], x1: &[[f64; 3]], unit: f64) -> Result<Pairing
         growth_pairs: 0,
         edges: n * n,
         certificate_examined: 0,
+        auction_bids: 0,
         seconds: start.elapsed().as_secs_f64(),
     })
 }
@@ -253,8 +259,24 @@ pub fn pair(
     Ok(s)
 }
 
-/// The sparse solver: renumber, build the kNN graph, solve (adding exit edges if it has
-/// no perfect matching), certify, repair, repeat.
+/// Bid budget of each auction call, per row. All calls together took 73–114 bids per
+/// row on the beds of docs/pairing.md; on a graph without a perfect matching an auction
+/// would bid forever.
+const AUCTION_BIDS_PER_ROW: u64 = 200;
+
+/// ε shrinks by this factor between auction phases.
+const AUCTION_THETA: i64 = 8;
+
+/// Certificate searches made on the auction's potentials, each followed by more
+/// auction on the enlarged graph (see `sparse`).
+const AUCTION_ROUNDS: usize = 2;
+
+/// With the certificate, the first auction pauses at its initial ε divided by this,
+/// and the auctions that follow the certificate searches start from there.
+const AUCTION_REFINE: i64 = 16;
+
+/// The sparse solver: renumber, build the kNN graph, warm-start with an auction, solve
+/// (adding exit edges if the graph has no perfect matching), certify, repair, repeat.
 fn sparse(
     x0_in: &[[f64; 3]],
     x1_in: &[[f64; 3]],
@@ -271,22 +293,85 @@ fn sparse(
     let (x0, x1) = (&x0[..], &x1[..]);
     let tree = candidates::build_tree(x0);
 
-    let k0 = opts.k_initial.min(n);
-    let (kc, kw) = candidates::knn(&tree, x0, x1, k0, scale);
+    let mut k0 = opts.k_initial.min(n);
+    let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
     let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+    let mut lap = sparse_lap::Lap::new(n);
+    lap.greedy_init(&graph);
+    // Warm start: the row reduction, then an ε-scaling auction. The auction moves the
+    // holes left by the row reduction (the long-range part of the transport) far more
+    // cheaply than one Dijkstra search per hole, which scans the whole region between
+    // the hole and a free column. While its potentials are near optimal, the
+    // certificate's search also runs on them, and the pairs it finds join the graph
+    // before the exact phase (`AUCTION_ROUNDS`). Only the auction's potentials and the
+    // matched pairs that satisfy the exact invariant are kept; the exact solver below
+    // does not depend on anything else the auction did.
+    let mut eps0 = sparse_lap::initial_eps(&graph);
+    let budget = AUCTION_BIDS_PER_ROW * n as u64;
+    // With the certificate, the auction pauses at ε0 / AUCTION_REFINE for the
+    // certificate searches below and resumes from there.
+    let eps_pause = |eps0: i64| {
+        if opts.certify {
+            (eps0 / AUCTION_REFINE).max(1)
+        } else {
+            1
+        }
+    };
+    let mut bids = lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+    // An auction that stops on its budget may be bidding on a graph without a perfect
+    // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
+    // redone: exit edges (the growth step below) are long, and their potentials make
+    // the certificate expensive. A real bed whose t1 shape differs slightly from t0's
+    // has no perfect matching at k = 12 or 16 (docs/pairing.md).
+    if lap.col_of_row.contains(&sparse_lap::NONE) && k0 < n {
+        let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
+        if !m.deficient_rows(&graph).is_empty() {
+            k0 = (2 * k0).min(n);
+            (kc, kw) = candidates::knn(&tree, x0, x1, k0, scale);
+            graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+            lap = sparse_lap::Lap::new(n);
+            lap.greedy_init(&graph);
+            eps0 = sparse_lap::initial_eps(&graph);
+            bids += lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+        }
+    }
+    let mut wtree: Option<certificate::WeightedTree> = None;
+    let mut added = 0usize;
+    let mut examined = 0u64;
+    let mut paused = eps_pause(eps0) > 1;
+    for _ in 0..AUCTION_ROUNDS {
+        if !opts.certify || lap.col_of_row.contains(&sparse_lap::NONE) {
+            break; // nothing to certify, or the auction stopped on its budget
+        }
+        let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
+        // A throwaway memo: these potentials satisfy ε-CS only, so a pass may also
+        // return candidate edges (dropped by the merge) and proves nothing.
+        let check = certificate::check(wtree, x1, &lap, scale, &mut certificate::Memo::default());
+        examined += check.examined;
+        if check.violations.is_empty() {
+            break;
+        }
+        let before = graph.edges();
+        extras = merge(extras, check.violations);
+        graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+        added += graph.edges() - before;
+        // The auction frees the rows undercut by more than ε by a new edge.
+        bids += lap.auction(&graph, eps_pause(eps0), AUCTION_THETA, 1, budget);
+        paused = false;
+    }
+    if paused && !lap.col_of_row.contains(&sparse_lap::NONE) {
+        bids += lap.auction(&graph, eps_pause(eps0), AUCTION_THETA, 1, budget);
+    }
+    lap.restore_invariant(&graph);
 
     // Optimal on the candidate graph, then the certificate; repair until it holds.
     // If a search finds no augmenting path, the graph has no perfect matching: add exit
     // edges on Hall-violating sets until Hopcroft–Karp finds a perfect matching, and
     // carry on from the same state.
-    let mut lap = sparse_lap::Lap::new(n);
-    lap.greedy_init(&graph);
-    let mut wtree: Option<certificate::WeightedTree> = None;
+    let mut memo = certificate::Memo::default();
     let mut rounds = 0u32;
-    let mut added = 0usize;
     let mut grown = 0usize;
-    let mut examined = 0u64;
     let certified = loop {
         rounds += 1;
         while let Err(failed) = lap.solve(&graph) {
@@ -315,7 +400,7 @@ fn sparse(
             break false;
         }
         let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
-        let check = certificate::check(wtree, x1, &lap, scale);
+        let check = certificate::check(wtree, x1, &lap, scale, &mut memo);
         examined += check.examined;
         if check.violations.is_empty() {
             break true;
@@ -344,6 +429,7 @@ fn sparse(
         growth_pairs: grown,
         edges: graph.edges(),
         certificate_examined: examined,
+        auction_bids: bids,
         seconds: 0.0,
     }
 }
