@@ -283,24 +283,19 @@ fn errors_section(d: &mut Document, c: &Comparison) {
             ks.join(", ")
         ))]));
     }
-    d.push(para(vec![
-        text("Mean temperature of the initially hot and cold particles, DEM against extrapolated (the paper's Figure 7; the extrapolation starts from the DEM state at t1): "),
-        link(MEANS_SVG, MEANS_SVG),
-        text("."),
-    ]));
-    d.push(Block::Image(
-        "Hot and cold group means over time, DEM and extrapolated".into(),
-        MEANS_SVG.into(),
-    ));
-    d.push(para(vec![
-        text("ε_rel, the Eq. 10 error and ε_abs per extrapolation step: "),
-        link(ERRORS_SVG, ERRORS_SVG),
-        text("."),
-    ]));
-    d.push(Block::Image(
-        "Relative, energy-transfer and absolute errors per extrapolation step".into(),
-        ERRORS_SVG.into(),
-    ));
+    figure(d, "Mean temperature of the initially hot and cold particles, DEM against extrapolated (the paper's Figure 7; the extrapolation starts from the DEM state at t1): ", MEANS_SVG, "Hot and cold group means over time, DEM and extrapolated");
+    figure(
+        d,
+        "ε_rel, the Eq. 10 error and ε_abs per extrapolation step: ",
+        ERRORS_SVG,
+        "Relative, energy-transfer and absolute errors per extrapolation step",
+    );
+}
+
+/// A paragraph `caption` linking `file`, then the image itself.
+fn figure(d: &mut Document, caption: &str, file: &str, alt: &str) {
+    d.push(para(vec![text(caption), link(file, file), text(".")]));
+    d.push(Block::Image(alt.into(), file.into()));
 }
 
 fn costs_section(d: &mut Document, inp: &Inputs) {
@@ -404,15 +399,7 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
         ],
     ]));
     if inp.plots.contains(&SPEEDUP_SVG) {
-        d.push(para(vec![
-            text("ε_rel at each compared t_k against the speedup of reaching t_k with k − 1 extrapolated periods: "),
-            link(SPEEDUP_SVG, SPEEDUP_SVG),
-            text("."),
-        ]));
-        d.push(Block::Image(
-            "Relative error against the speedup of reaching each t_k".into(),
-            SPEEDUP_SVG.into(),
-        ));
+        figure(d, "ε_rel at each compared t_k against the speedup of reaching t_k with k − 1 extrapolated periods: ", SPEEDUP_SVG, "Relative error against the speedup of reaching each t_k");
     }
 }
 

@@ -5,6 +5,8 @@
 use super::costs::CostTable;
 use crate::compare::Comparison;
 use anyhow::Result;
+use plotters::chart::MeshStyle;
+use plotters::coord::ranged1d::{AsRangedCoord, ValueFormatter};
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -12,18 +14,18 @@ use plotters::style::text_anchor;
 use recorder::format::Snapshot;
 use std::ops::Range;
 
-const FONT: &str = "sans-serif";
-const SIZE: (u32, u32) = (820, 520);
-const HOT: RGBColor = RGBColor(200, 35, 35);
+pub(crate) const FONT: &str = "sans-serif";
+pub(crate) const SIZE: (u32, u32) = (820, 520);
+pub(crate) const HOT: RGBColor = RGBColor(200, 35, 35);
 const HOT_LIGHT: RGBColor = RGBColor(245, 140, 60);
-const COLD: RGBColor = RGBColor(35, 80, 200);
+pub(crate) const COLD: RGBColor = RGBColor(35, 80, 200);
 const COLD_LIGHT: RGBColor = RGBColor(40, 170, 200);
-const GREY: RGBColor = RGBColor(120, 120, 120);
+pub(crate) const GREY: RGBColor = RGBColor(120, 120, 120);
 
-type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
 /// Draws onto a white `size` SVG canvas and returns the document.
-fn render(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<String> {
+pub(crate) fn render(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<String> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
@@ -32,6 +34,42 @@ fn render(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<St
         root.present()?;
     }
     Ok(svg)
+}
+
+/// A chart on `area` in the report's style: the title, margins and label areas of every
+/// single-panel plot.
+pub(crate) fn chart<'a, 'b, X: AsRangedCoord, Y: AsRangedCoord>(
+    area: &'a Area<'b>,
+    title: &str,
+    x: X,
+    y: Y,
+) -> Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<X::CoordDescType, Y::CoordDescType>>> {
+    Ok(ChartBuilder::on(area)
+        .caption(title, (FONT, 20))
+        .margin(12)
+        .x_label_area_size(48)
+        .y_label_area_size(70)
+        .build_cartesian_2d(x, y)?)
+}
+
+/// The mesh in the report's style with its axis descriptions; the caller adds label
+/// formatters and draws it.
+pub(crate) fn axes<'c, 'a, 'b, X, Y>(
+    chart: &'c mut ChartContext<'a, SVGBackend<'b>, Cartesian2d<X, Y>>,
+    x_desc: &str,
+    y_desc: &str,
+) -> MeshStyle<'a, 'c, X, Y, SVGBackend<'b>>
+where
+    X: Ranged + ValueFormatter<X::ValueType>,
+    Y: Ranged + ValueFormatter<Y::ValueType>,
+{
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style((FONT, 15))
+        .label_style((FONT, 13))
+        .light_line_style(RGBColor(235, 235, 235));
+    mesh
 }
 
 /// A padded axis range over the finite `values` (and `include`); never empty.
@@ -88,7 +126,7 @@ fn integer_tick(v: f64) -> String {
     }
 }
 
-fn message(area: &Area, text: &str) -> Result<()> {
+pub(crate) fn message(area: &Area, text: &str) -> Result<()> {
     let (w, h) = area.dim_in_pixel();
     let style = TextStyle::from((FONT, 18).into_font())
         .color(&GREY)
@@ -135,25 +173,16 @@ pub fn means(c: &Comparison) -> Result<String> {
         let has_groups = temps.clone().next().is_some();
         let x = span(dem.iter().chain(&extra).map(|p| p.0), &[], 0.03);
         let y = span(temps, &[], 0.08);
-        let mut chart = ChartBuilder::on(root)
-            .caption(
-                "Mean temperature of the initially hot and cold particles",
-                (FONT, 20),
-            )
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x.clone(), y.clone())?;
+        let mut chart = chart(
+            root,
+            "Mean temperature of the initially hot and cold particles",
+            x.clone(),
+            y.clone(),
+        )?;
         let (fx, fy) = (ticks(&x), ticks(&y));
-        chart
-            .configure_mesh()
-            .x_desc("time t (s)")
-            .y_desc("mean temperature (K)")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
+        axes(&mut chart, "time t (s)", "mean temperature (K)")
             .x_label_formatter(&fx)
             .y_label_formatter(&fy)
-            .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         if !has_groups {
             return message(
@@ -239,15 +268,10 @@ pub fn errors(c: &Comparison) -> Result<String> {
             .x_label_area_size(42)
             .y_label_area_size(70)
             .build_cartesian_2d(x.clone(), y)?;
-        top.configure_mesh()
-            .x_desc("extrapolation step k (t_k)")
-            .y_desc("error (%)")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
+        axes(&mut top, "extrapolation step k (t_k)", "error (%)")
             .x_labels(n_labels)
             .x_label_formatter(&|v| integer_tick(*v))
             .y_label_formatter(&fy)
-            .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         if rel.is_empty() && energy.is_empty() {
             message(&panels[0], "ε_rel and the Eq. 10 error are undefined here")?;
@@ -291,16 +315,10 @@ pub fn errors(c: &Comparison) -> Result<String> {
             .x_label_area_size(42)
             .y_label_area_size(70)
             .build_cartesian_2d(x, y)?;
-        bottom
-            .configure_mesh()
-            .x_desc("extrapolation step k (t_k)")
-            .y_desc("ε_abs (K)")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
+        axes(&mut bottom, "extrapolation step k (t_k)", "ε_abs (K)")
             .x_labels(n_labels)
             .x_label_formatter(&|v| integer_tick(*v))
             .y_label_formatter(&fy)
-            .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         bottom.draw_series(LineSeries::new(abs.clone(), BLACK.stroke_width(2)))?;
         bottom.draw_series(abs.iter().map(|&p| Circle::new(p, 4, BLACK.filled())))?;
@@ -329,22 +347,20 @@ pub fn error_vs_speedup(c: &Comparison, costs: &CostTable) -> Result<String> {
         let x = span(points.iter().map(|p| p.1), &[1.0], 0.08);
         let y = span(points.iter().map(|p| p.2), &[0.0], 0.12);
         let (fx, fy) = (ticks(&x), ticks(&y));
-        let mut chart = ChartBuilder::on(root)
-            .caption("Error against speedup at each compared t_k", (FONT, 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x, y.clone())?;
-        chart
-            .configure_mesh()
-            .x_desc("speedup of reaching t_k (complete DEM s / extrapolated DEM s)")
-            .y_desc(if use_rel { "ε_rel (%)" } else { "ε_abs (K)" })
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
-            .x_label_formatter(&fx)
-            .y_label_formatter(&fy)
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        let mut chart = chart(
+            root,
+            "Error against speedup at each compared t_k",
+            x,
+            y.clone(),
+        )?;
+        axes(
+            &mut chart,
+            "speedup of reaching t_k (complete DEM s / extrapolated DEM s)",
+            if use_rel { "ε_rel (%)" } else { "ε_abs (K)" },
+        )
+        .x_label_formatter(&fx)
+        .y_label_formatter(&fy)
+        .draw()?;
         chart.draw_series(DashedLineSeries::new(
             vec![(1.0, y.start), (1.0, y.end)],
             4,
@@ -393,22 +409,20 @@ pub fn duration_cdf(histogram: &[u64], n: u32, dtc_max_steps: u32) -> Result<Str
             .max(dtc_max_steps as f64)
             * 1.3;
         let x_min = cdf.first().map_or(n, |p| p.0).min(n) / 1.3;
-        let mut chart = ChartBuilder::on(root)
-            .caption("Cumulative distribution of collision durations", (FONT, 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x_min.max(0.5)..x_max).log_scale(), 0.0..1.02)?;
-        chart
-            .configure_mesh()
-            .x_desc("collision duration (DEM steps, s·n for s consecutive samples)")
-            .y_desc("fraction of collisions lasting ≤ x")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
-            .x_label_formatter(&|v| tick(*v))
-            .y_label_formatter(&|v| tick(*v))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        let mut chart = chart(
+            root,
+            "Cumulative distribution of collision durations",
+            (x_min.max(0.5)..x_max).log_scale(),
+            0.0..1.02,
+        )?;
+        axes(
+            &mut chart,
+            "collision duration (DEM steps, s·n for s consecutive samples)",
+            "fraction of collisions lasting ≤ x",
+        )
+        .x_label_formatter(&|v| tick(*v))
+        .y_label_formatter(&|v| tick(*v))
+        .draw()?;
         if cdf.is_empty() {
             return message(root, "no collisions were recorded");
         }

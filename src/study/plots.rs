@@ -2,15 +2,9 @@
 //! `<text>`, 820×520, sans-serif; the same inputs give the same bytes), with its axis
 //! helpers.
 
-use crate::report::plots::{span, tick};
+use crate::report::plots::{axes, chart, message, render, span, tick, COLD, FONT, GREY, HOT, SIZE};
 use anyhow::Result;
 use plotters::prelude::*;
-
-const FONT: &str = "sans-serif";
-const SIZE: (u32, u32) = (820, 520);
-const HOT: RGBColor = RGBColor(200, 35, 35);
-const COLD: RGBColor = RGBColor(35, 80, 200);
-const GREY: RGBColor = RGBColor(120, 120, 120);
 
 /// Labelled points `(x, y, label)`; a message instead when there are none.
 pub fn scatter(
@@ -19,44 +13,24 @@ pub fn scatter(
     y_desc: &str,
     points: &[(f64, f64, String)],
 ) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
+    render(SIZE, |root| {
         let x = span(points.iter().map(|p| p.0), &[], 0.12);
         let y = span(points.iter().map(|p| p.1), &[0.0], 0.12);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FONT, 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x, y)?;
-        chart
-            .configure_mesh()
-            .x_desc(x_desc)
-            .y_desc(y_desc)
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
+        let mut chart = chart(root, title, x, y)?;
+        axes(&mut chart, x_desc, y_desc)
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
-            .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         if points.is_empty() {
-            let (w, h) = root.dim_in_pixel();
-            root.draw_text(
-                "no run was extrapolated",
-                &TextStyle::from((FONT, 18).into_font()).color(&GREY),
-                (w as i32 / 3, h as i32 / 2),
-            )?;
+            message(root, "no run was extrapolated")?;
         }
         chart.draw_series(points.iter().map(|(x, y, label)| {
             EmptyElement::at((*x, *y))
                 + Circle::new((0, 0), 5, HOT.filled())
                 + Text::new(label.clone(), (7, -16), (FONT, 13).into_font())
         }))?;
-        root.present()?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }
 
 /// One series of group means over time.
@@ -71,28 +45,14 @@ pub struct Series {
 /// Figures 13–15: hot and cold group means over time, the DEM as lines and each
 /// extrapolation as markers (one shape per series).
 pub fn means(title: &str, series: &[Series]) -> Result<String> {
-    let mut svg = String::new();
-    {
-        let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        root.fill(&WHITE)?;
+    render(SIZE, |root| {
         let all = || series.iter().flat_map(|s| s.points.iter());
         let x = span(all().map(|p| p.0), &[], 0.03);
         let y = span(all().flat_map(|p| [p.1, p.2]), &[], 0.08);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, (FONT, 20))
-            .margin(12)
-            .x_label_area_size(48)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x, y)?;
-        chart
-            .configure_mesh()
-            .x_desc("t (s)")
-            .y_desc("group mean temperature (K)")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
+        let mut chart = chart(root, title, x, y)?;
+        axes(&mut chart, "t (s)", "group mean temperature (K)")
             .x_label_formatter(&|v| tick(*v))
             .y_label_formatter(&|v| tick(*v))
-            .light_line_style(RGBColor(235, 235, 235))
             .draw()?;
         let mut marker = 0;
         for s in series {
@@ -140,7 +100,6 @@ pub fn means(title: &str, series: &[Series]) -> Result<String> {
             .label_font((FONT, 13))
             .position(SeriesLabelPosition::UpperRight)
             .draw()?;
-        root.present()?;
-    }
-    Ok(svg)
+        Ok(())
+    })
 }
