@@ -120,95 +120,185 @@ pub fn record_from_t0(
     seconds_to_t0: f64,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<RecordingSummary, RecordError> {
-    let sampler = check(opts)?;
-    let info = recording_info(sim, case_path, case_toml, opts);
-    let mut writer = RecordingWriter::create(dest, info)?;
-    writer.write_snapshot(&sim.snapshot(0))?;
+    let job = RecordJob {
+        options: opts.clone(),
+        dest,
+    };
+    let mut summaries =
+        record_many_from_t0(sim, case_path, case_toml, &[job], seconds_to_t0, progress)?;
+    Ok(summaries.pop().expect("one summary per job"))
+}
+
+/// One recording of [`record_many_from_t0`]: its settings and its file.
+#[derive(Debug, Clone)]
+pub struct RecordJob<'a> {
+    pub options: RecordOptions,
+    pub dest: &'a Path,
+}
+
+/// Records several samplings of one DEM run: the simulation standing at `t0` is stepped
+/// once through the period and the reference periods, and every job's sampler is fed the
+/// contact list at its own steps (`k` a multiple of its `n`). Sampling only reads the state,
+/// so each file holds the table and snapshots that a run with its options alone would write;
+/// only the costs differ: `seconds_period` is the period's wall time (shared) and
+/// `seconds_recorder` the job's own sampler, splitter and writer time. Jobs must share
+/// `period_steps` and `reference_periods`.
+pub fn record_many_from_t0(
+    sim: &mut Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    jobs: &[RecordJob],
+    seconds_to_t0: f64,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Vec<RecordingSummary>, RecordError> {
+    let Some(first) = jobs.first() else {
+        return Ok(Vec::new());
+    };
+    let (period_steps, reference_periods) =
+        (first.options.period_steps, first.options.reference_periods);
+    if jobs.iter().any(|j| {
+        j.options.period_steps != period_steps || j.options.reference_periods != reference_periods
+    }) {
+        return Err(RecordError::Settings(
+            "the recordings of one run must share τ and the reference periods".into(),
+        ));
+    }
+    let samplers = jobs
+        .iter()
+        .map(|j| check(&j.options))
+        .collect::<Result<Vec<_>, _>>()?;
+    let t0 = sim.snapshot(0);
+    let mut writers = Vec::with_capacity(jobs.len());
+    for j in jobs {
+        let info = recording_info(sim, case_path, case_toml, &j.options);
+        let mut writer = RecordingWriter::create(j.dest, info)?;
+        writer.write_snapshot(&t0)?;
+        writers.push(writer);
+    }
 
     let period_start = Instant::now();
-    let (sampler, recorder_seconds) = record_period(sim, sampler, &mut writer, opts, progress)?;
-    let t = Instant::now();
-    writer.write_snapshot(&sim.snapshot(1))?;
-    let recorder_seconds = recorder_seconds + t.elapsed().as_secs_f64();
+    let every: Vec<u64> = jobs.iter().map(|j| j.options.sample_every as u64).collect();
+    let (samplers, mut recorder_seconds) =
+        record_period(sim, samplers, &mut writers, &every, period_steps, progress)?;
+    let t1 = sim.snapshot(1);
+    for (writer, busy) in writers.iter_mut().zip(&mut recorder_seconds) {
+        let t = Instant::now();
+        writer.write_snapshot(&t1)?;
+        *busy += t.elapsed().as_secs_f64();
+    }
     let seconds_period = period_start.elapsed().as_secs_f64();
 
     let reference_start = Instant::now();
-    let reference_steps = opts.reference_periods as u64 * opts.period_steps;
-    for period in 0..opts.reference_periods {
-        let done = period as u64 * opts.period_steps;
-        sim.run(opts.period_steps, REPORT_EVERY, &mut |s| {
+    let reference_steps = reference_periods as u64 * period_steps;
+    for period in 0..reference_periods {
+        let done = period as u64 * period_steps;
+        sim.run(period_steps, REPORT_EVERY, &mut |s| {
             progress(Phase::Reference, done + s, reference_steps)
         })?;
-        writer.write_snapshot(&sim.snapshot(period + 2))?;
+        let snapshot = sim.snapshot(period + 2);
+        for writer in &mut writers {
+            writer.write_snapshot(&snapshot)?;
+        }
     }
-    let costs = RecordingCosts {
-        seconds_to_t0,
-        seconds_period,
-        seconds_reference: reference_start.elapsed().as_secs_f64(),
-        seconds_recorder: recorder_seconds,
-        stage_seconds: sim
-            .counters
-            .stages()
-            .iter()
-            .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
-            .collect(),
-        threads: rayon::current_num_threads(),
-    };
-    Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+    let seconds_reference = reference_start.elapsed().as_secs_f64();
+    let stage_seconds: std::collections::BTreeMap<String, f64> = sim
+        .counters
+        .stages()
+        .iter()
+        .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
+        .collect();
+    writers
+        .into_iter()
+        .zip(samplers)
+        .zip(recorder_seconds)
+        .map(|((writer, sampler), seconds_recorder)| {
+            let costs = RecordingCosts {
+                seconds_to_t0,
+                seconds_period,
+                seconds_reference,
+                seconds_recorder,
+                stage_seconds: stage_seconds.clone(),
+                threads: rayon::current_num_threads(),
+            };
+            Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+        })
+        .collect()
 }
 
 /// Contact lists in flight between the DEM and the recorder thread.
 const SAMPLES_IN_FLIGHT: usize = 4;
 
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
 /// The period `[t0, t1]`: the DEM steps on the calling thread (and its pool) while a recorder
-/// thread samples, splits, encodes and writes. Each sample is the contact list copied at its
-/// step, so the table is the same as a serial recorder's, whatever the timing; the recorder
-/// fills the cores the DEM leaves idle instead of stalling it. Returns the finished sampler
-/// (for its histogram) and the recorder thread's busy seconds.
+/// thread samples, splits, encodes and writes for every job (sampler `i` takes the steps
+/// that are multiples of `every[i]`). Each sample is the contact list copied at its step, so
+/// the tables are the same as a serial recorder's, whatever the timing; the recorder fills
+/// the cores the DEM leaves idle instead of stalling it. Returns the finished samplers (for
+/// their histograms) and each job's busy seconds on the recorder thread.
 fn record_period(
     sim: &mut Simulation,
-    mut sampler: ContactSampler,
-    writer: &mut RecordingWriter,
-    opts: &RecordOptions,
+    mut samplers: Vec<ContactSampler>,
+    writers: &mut [RecordingWriter],
+    every: &[u64],
+    period_steps: u64,
     progress: &mut dyn FnMut(Phase, u64, u64),
-) -> Result<(ContactSampler, f64), RecordError> {
+) -> Result<(Vec<ContactSampler>, Vec<f64>), RecordError> {
     type Sample = Vec<(u32, u32, f64)>;
-    let every = opts.sample_every as u64;
+    // every sampled step is a multiple of the stride; the DEM steps that far between checks
+    let stride = every.iter().copied().fold(0, gcd);
     let (to_recorder, samples) = mpsc::sync_channel::<(u64, Sample)>(SAMPLES_IN_FLIGHT);
     let (to_dem, spare) = mpsc::channel::<Sample>();
     std::thread::scope(|scope| {
-        let recorder = scope.spawn(move || -> Result<(ContactSampler, f64), FormatError> {
-            let mut busy = 0.0;
-            for (step, contacts) in samples {
-                let t = Instant::now();
-                sampler.sample(step, contacts.iter().copied());
-                writer.push_rows(sampler.drain_ready())?;
-                let _ = to_dem.send(contacts);
-                busy += t.elapsed().as_secs_f64();
-            }
-            let t = Instant::now();
-            writer.push_rows(sampler.finish())?;
-            Ok((sampler, busy + t.elapsed().as_secs_f64()))
-        });
+        let recorder = scope.spawn(
+            move || -> Result<(Vec<ContactSampler>, Vec<f64>), FormatError> {
+                let mut busy = vec![0.0; samplers.len()];
+                for (step, contacts) in samples {
+                    for (i, sampler) in samplers.iter_mut().enumerate() {
+                        if step % every[i] == 0 {
+                            let t = Instant::now();
+                            sampler.sample(step, contacts.iter().copied());
+                            writers[i].push_rows(sampler.drain_ready())?;
+                            busy[i] += t.elapsed().as_secs_f64();
+                        }
+                    }
+                    let _ = to_dem.send(contacts);
+                }
+                for (i, sampler) in samplers.iter_mut().enumerate() {
+                    let t = Instant::now();
+                    writers[i].push_rows(sampler.finish())?;
+                    busy[i] += t.elapsed().as_secs_f64();
+                }
+                Ok((samplers, busy))
+            },
+        );
         let mut dem = || -> Result<(), RecordError> {
             let mut k = 0;
-            while k < opts.period_steps {
+            while k < period_steps {
                 // sample k is the contact list that conducted during DEM step k, from
                 // t0 + k dt to t0 + (k+1) dt: the list the step has just computed
                 sim.step();
-                let mut contacts = spare.try_recv().unwrap_or_default();
-                contacts.clear();
-                contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
-                if to_recorder.send((k, contacts)).is_err() {
-                    return Ok(()); // the recorder stopped: its error is reported below
+                if every.iter().any(|e| k % e == 0) {
+                    let mut contacts = spare.try_recv().unwrap_or_default();
+                    contacts.clear();
+                    contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
+                    if to_recorder.send((k, contacts)).is_err() {
+                        return Ok(()); // the recorder stopped: its error is reported below
+                    }
                 }
-                for _ in 1..every {
+                for _ in 1..stride {
                     sim.step();
                 }
                 sim.check_inside()?;
-                k += every;
-                if k % REPORT_EVERY < every || k == opts.period_steps {
-                    progress(Phase::Period, k, opts.period_steps);
+                k += stride;
+                if k % REPORT_EVERY < stride || k == period_steps {
+                    progress(Phase::Period, k, period_steps);
                 }
             }
             Ok(())
@@ -264,130 +354,4 @@ fn recording_info(
         heat_capacity: case.material.heat_capacity,
         conductivity: case.material.conductivity,
     }
-}
-
-/// One recording of [`record_many_from_t0`]: its settings and its file.
-#[derive(Debug, Clone)]
-pub struct RecordJob<'a> {
-    pub options: RecordOptions,
-    pub dest: &'a Path,
-}
-
-/// Records several samplings of the same DEM run: one simulation standing at `t0` is stepped
-/// once through the period and the reference periods, and every job's sampler is fed the
-/// contact list at its own steps (`k` a multiple of its `n`). The DEM trajectory does not
-/// depend on the sampling (sampling only reads the state), so each file holds the table and
-/// snapshots that [`record_from_t0`] would write for its options alone; only the costs differ:
-/// each file's `seconds_period` is the DEM's stepping time plus its own sampler's time (its
-/// `seconds_recorder`), measured on the calling thread (no recorder thread here). Jobs must
-/// share `period_steps` and `reference_periods`. `tdex record` does not use this function.
-pub fn record_many_from_t0(
-    sim: &mut Simulation,
-    case_path: &Path,
-    case_toml: &str,
-    jobs: &[RecordJob],
-    seconds_to_t0: f64,
-    progress: &mut dyn FnMut(Phase, u64, u64),
-) -> Result<Vec<RecordingSummary>, RecordError> {
-    let Some(first) = jobs.first() else {
-        return Ok(Vec::new());
-    };
-    let (period_steps, reference_periods) =
-        (first.options.period_steps, first.options.reference_periods);
-    if jobs.iter().any(|j| {
-        j.options.period_steps != period_steps || j.options.reference_periods != reference_periods
-    }) {
-        return Err(RecordError::Settings(
-            "the recordings of one run must share τ and the reference periods".into(),
-        ));
-    }
-    let mut samplers = jobs
-        .iter()
-        .map(|j| check(&j.options))
-        .collect::<Result<Vec<_>, _>>()?;
-    let mut writers = Vec::with_capacity(jobs.len());
-    let t0 = sim.snapshot(0);
-    for j in jobs {
-        let info = recording_info(sim, case_path, case_toml, &j.options);
-        let mut writer = RecordingWriter::create(j.dest, info)?;
-        writer.write_snapshot(&t0)?;
-        writers.push(writer);
-    }
-
-    let mut dem_seconds = 0.0;
-    let mut sampler_seconds = vec![0.0; jobs.len()];
-    let every_min = jobs
-        .iter()
-        .map(|j| j.options.sample_every as u64)
-        .min()
-        .expect("at least one job");
-    let mut contacts: Vec<(u32, u32, f64)> = Vec::new();
-    for k in 0..period_steps {
-        let t = Instant::now();
-        sim.step();
-        dem_seconds += t.elapsed().as_secs_f64();
-        let wanted: Vec<usize> = (0..jobs.len())
-            .filter(|&i| k % jobs[i].options.sample_every as u64 == 0)
-            .collect();
-        if !wanted.is_empty() {
-            contacts.clear();
-            contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
-            for i in wanted {
-                let t = Instant::now();
-                samplers[i].sample(k, contacts.iter().copied());
-                writers[i].push_rows(samplers[i].drain_ready())?;
-                sampler_seconds[i] += t.elapsed().as_secs_f64();
-            }
-        }
-        let done = k + 1;
-        if done % every_min == 0 {
-            sim.check_inside()?;
-        }
-        if done % REPORT_EVERY == 0 || done == period_steps {
-            progress(Phase::Period, done, period_steps);
-        }
-    }
-    let t1 = sim.snapshot(1);
-    for (i, w) in writers.iter_mut().enumerate() {
-        let t = Instant::now();
-        w.push_rows(samplers[i].finish())?;
-        w.write_snapshot(&t1)?;
-        sampler_seconds[i] += t.elapsed().as_secs_f64();
-    }
-
-    let reference_start = Instant::now();
-    let reference_steps = reference_periods as u64 * period_steps;
-    for period in 0..reference_periods {
-        let done = period as u64 * period_steps;
-        sim.run(period_steps, REPORT_EVERY, &mut |s| {
-            progress(Phase::Reference, done + s, reference_steps)
-        })?;
-        let snapshot = sim.snapshot(period + 2);
-        for w in writers.iter_mut() {
-            w.write_snapshot(&snapshot)?;
-        }
-    }
-    let seconds_reference = reference_start.elapsed().as_secs_f64();
-    let stage_seconds: std::collections::BTreeMap<String, f64> = sim
-        .counters
-        .stages()
-        .iter()
-        .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
-        .collect();
-    writers
-        .into_iter()
-        .zip(samplers)
-        .zip(sampler_seconds)
-        .map(|((writer, sampler), recorder_seconds)| {
-            let costs = RecordingCosts {
-                seconds_to_t0,
-                seconds_period: dem_seconds + recorder_seconds,
-                seconds_reference,
-                seconds_recorder: recorder_seconds,
-                stage_seconds: stage_seconds.clone(),
-                threads: rayon::current_num_threads(),
-            };
-            Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
-        })
-        .collect()
 }
