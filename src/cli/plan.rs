@@ -381,6 +381,11 @@ fn check_output(output: &std::path::Path) -> Result<()> {
             output.display()
         )));
     }
+    check_parent(output)
+}
+
+/// The directory that will hold `output` must exist.
+fn check_parent(output: &std::path::Path) -> Result<()> {
     let parent = output
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -412,18 +417,7 @@ fn check_output_dir(dir: &std::path::Path) -> Result<()> {
             dir.display()
         )));
     }
-    let parent = dir
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    if !parent.is_dir() {
-        return Err(usage(format!(
-            "-o {}: the directory {} does not exist",
-            dir.display(),
-            parent.display()
-        )));
-    }
-    Ok(())
+    check_parent(dir)
 }
 
 /// A comma-separated list of values for `flag`: no empty list, no empty or unparsable item;
