@@ -40,10 +40,10 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
     let bodies = Bodies::of(&info, &t0);
 
     let started = Instant::now();
-    let (stored, reused) = match pair::load(&reader) {
+    let (stored, reused) = match pair::load(&reader, &t0, &t1) {
         Some(stored) => (stored, true),
         None => {
-            let stored = pair::compute(&reader, &t0, &t1)?;
+            let stored = pair::compute(&t0, &t1)?;
             pair::store(&reader, &stored)?;
             (stored, false)
         }

@@ -25,8 +25,8 @@ pub struct PairingSummary {
 /// The stored pairing: `g[p]` = the role particle `p` takes in the next period.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct StoredPairing {
-    /// Size of the recording it belongs to (a different file is not reused).
-    pub recording_bytes: u64,
+    /// [`fingerprint`] of the snapshots it pairs: reused only for the same positions.
+    pub snapshots_fingerprint: u64,
     pub summary: PairingSummary,
     pub g: Vec<u32>,
 }
@@ -35,11 +35,6 @@ pub fn sidecar(recording: &Path) -> PathBuf {
     let mut name = recording.as_os_str().to_owned();
     name.push(".pairing.json");
     PathBuf::from(name)
-}
-
-/// Mean diameter of a snapshot's particles.
-fn diameter(snap: &Snapshot) -> f64 {
-    2.0 * snap.radius.iter().sum::<f64>() / snap.len().max(1) as f64
 }
 
 /// The snapshots at `t0` and `t1` that bound the recorded period.
@@ -53,12 +48,24 @@ pub fn period_snapshots(reader: &RecordingReader) -> Result<(Snapshot, Snapshot)
     Ok((t0, t1))
 }
 
+/// A hash of the positions at `t0` and `t1`, the pairing's only input: a stored pairing
+/// is reused for these snapshots and no others (a recording made again with another case
+/// or seed into the same file name has other positions).
+pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    for p in t0.pos.iter().chain(&t1.pos) {
+        p.map(f64::to_bits).hash(&mut h);
+    }
+    h.finish()
+}
+
 /// Computes the pairing of the recording's snapshots at `t0` and `t1`.
-pub fn compute(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing> {
-    let d = diameter(t0);
+pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing> {
+    let d = t0.mean_diameter();
     let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
     Ok(StoredPairing {
-        recording_bytes: reader.file_bytes(),
+        snapshots_fingerprint: fingerprint(t0, t1),
         summary: PairingSummary {
             particles: p.g.len(),
             diameter: d,
@@ -74,8 +81,8 @@ pub fn compute(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Result
     })
 }
 
-/// The stored pairing of this recording, if there is one that matches it.
-pub fn load(reader: &RecordingReader) -> Option<StoredPairing> {
+/// The stored pairing of this recording's snapshots `t0` and `t1`, if one matches them.
+pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<StoredPairing> {
     let text = std::fs::read_to_string(sidecar(reader.path())).ok()?;
     let stored: StoredPairing = serde_json::from_str(&text).ok()?;
     let n = reader.info().particles as usize;
@@ -87,7 +94,7 @@ pub fn load(reader: &RecordingReader) -> Option<StoredPairing> {
                 .iter()
                 .all(|&r| (r as usize) < n && !std::mem::replace(&mut seen[r as usize], true))
     };
-    (stored.recording_bytes == reader.file_bytes() && permutation).then_some(stored)
+    (stored.snapshots_fingerprint == fingerprint(t0, t1) && permutation).then_some(stored)
 }
 
 /// Writes the pairing beside the recording (temporary file, then rename).
@@ -103,7 +110,7 @@ pub fn store(reader: &RecordingReader, stored: &StoredPairing) -> Result<PathBuf
 pub fn run(plan: &PairPlan) -> Result<()> {
     let reader = RecordingReader::open(&plan.file)?;
     let (t0, t1) = period_snapshots(&reader)?;
-    let stored = crate::with_workers(plan.threads, || compute(&reader, &t0, &t1))?;
+    let stored = crate::with_workers(plan.threads, || compute(&t0, &t1))?;
     let path = store(&reader, &stored)?;
     let s = &stored.summary;
     if plan.json {

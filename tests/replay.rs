@@ -138,3 +138,31 @@ fn the_explicit_scheme_refuses_an_unstable_table_and_names_the_row() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(extra.exists());
 }
+
+#[test]
+fn a_stored_pairing_is_reused_only_for_the_same_snapshots() {
+    let dir = tempfile::tempdir().unwrap();
+    let extra = dir.path().join("extra.mcap");
+    let extrapolate = |run: &Path| -> serde_json::Value {
+        let o = run_tdex(&[
+            "extrapolate",
+            run.to_str().unwrap(),
+            "--periods",
+            "1",
+            "-o",
+            extra.to_str().unwrap(),
+            "--json",
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_slice(&o.stdout).unwrap()
+    };
+    let flags = ["--tau-rev", "0.25"];
+    let run = record(dir.path(), TINY_CASE, &flags);
+    assert_eq!(extrapolate(&run)["costs"]["pairing_reused"], false);
+    assert_eq!(extrapolate(&run)["costs"]["pairing_reused"], true);
+    // Another packing recorded into the same file: its pairing is computed afresh.
+    let other = TINY_CASE.replace("seed = 5", "seed = 6");
+    assert_ne!(other, TINY_CASE);
+    let run = record(dir.path(), &other, &flags);
+    assert_eq!(extrapolate(&run)["costs"]["pairing_reused"], false);
+}

@@ -259,7 +259,7 @@ pub struct FlowMeasure {
 /// Measures the flow in `snapshot` of a drum of `radius` turning at `w`; bins one mean
 /// particle diameter wide.
 pub fn measure(snapshot: &Snapshot, w: f64, radius: f64) -> FlowMeasure {
-    let d = 2.0 * snapshot.radius.iter().sum::<f64>() / snapshot.len().max(1) as f64;
+    let d = snapshot.mean_diameter();
     let points = surface_points(&snapshot.pos, &snapshot.radius, d, SURFACE_KEEP);
     let line = fit_line(&points);
     let x_range = points

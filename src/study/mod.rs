@@ -143,16 +143,31 @@ pub(crate) fn num(x: Option<f64>, digits: usize) -> String {
     x.map_or("-".into(), |v| format!("{v:.digits$}"))
 }
 
-/// Prints the study: its JSON, or the table and the files written.
-pub(crate) fn print_outcome(json: bool, json_text: &str, table: &str, files: &[PathBuf]) {
-    if json {
-        println!("{json_text}");
+/// Writes the study into its directory (`study.json`, the plots, `study.md`) and prints
+/// its JSON, or the table and the files written.
+pub(crate) fn finish(
+    plan: &StudyPlan,
+    study: &impl Serialize,
+    table: &str,
+    markdown: &str,
+    svgs: Vec<(&str, String)>,
+) -> Result<()> {
+    let json = serde_json::to_string_pretty(study)?;
+    let dir = &plan.output;
+    let mut files = vec![write_file(dir, "study.json", &json)?];
+    for (name, svg) in &svgs {
+        files.push(write_file(dir, name, svg)?);
+    }
+    files.push(write_file(dir, "study.md", markdown)?);
+    if plan.json {
+        println!("{json}");
     } else {
         print!("{table}");
         for f in files {
             println!("wrote         {}", f.display());
         }
     }
+    Ok(())
 }
 
 /// Writes `dir/name` (through a temporary file renamed into place); returns its path.

@@ -2,7 +2,7 @@
 //! The DEM runs once to t0; from a copy of that state each τ is recorded (as `tdex record`
 //! does) with a DEM reference over R revolutions, extrapolated R/τ periods and compared.
 
-use super::{evaluate, num, pct, plots, run_paths, write_file, Outcome};
+use super::{evaluate, num, pct, plots, run_paths, Outcome};
 use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
 use recorder::record::{self, RecordOptions};
@@ -54,7 +54,6 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
     for (f, o) in runs {
         let stem = format!("tau{f}rev");
         let (rec, extra) = run_paths(dir, &stem);
-        let _ = std::fs::remove_file(crate::pair::sidecar(&rec));
         let mut sim = sim0.clone();
         crate::with_workers(plan.threads, || {
             Ok(record::record_from_t0(
@@ -88,9 +87,7 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
         seconds_to_t0,
         runs: entries,
     };
-    let json = serde_json::to_string_pretty(&study)?;
-    let table = table(&study);
-    let mut files = vec![write_file(dir, "study.json", &json)?];
+    let mut svgs: Vec<(&str, String)> = Vec::new();
     let points: Vec<(f64, f64, String)> = study
         .runs
         .iter()
@@ -102,16 +99,15 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
             ))
         })
         .collect();
-    files.push(write_file(
-        dir,
+    svgs.push((
         "error_vs_speedup.svg",
-        &plots::scatter(
+        plots::scatter(
             "Maximum ε_rel against the speedup for 100 τ, per pairing period",
             "speedup of reaching t1 + 100 τ",
             "max ε_rel over the t_k (%)",
             &points,
         )?,
-    )?);
+    ));
     let mut series = Vec::new();
     if let Some(c) = study
         .runs
@@ -148,14 +144,12 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
             });
         }
     }
-    files.push(write_file(
-        dir,
+    svgs.push((
         "means.svg",
-        &plots::means("Hot and cold group means per pairing period", &series)?,
-    )?);
-    files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    super::print_outcome(plan.json, &json, &table, &files);
-    Ok(())
+        plots::means("Hot and cold group means per pairing period", &series)?,
+    ));
+    let table = table(&study);
+    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
 }
 
 fn table(s: &PeriodStudy) -> String {

@@ -81,7 +81,6 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
     for r in runs {
         let stem = format!("rev{}s", r.rotation_period);
         let (rec, extra) = run_paths(dir, &stem);
-        let _ = std::fs::remove_file(crate::pair::sidecar(&rec));
         let case_path = dir.join(format!("{stem}.toml"));
         write_file(dir, &format!("{stem}.toml"), &r.case_toml)?;
         let omega = r.case.angular_velocity();
@@ -117,7 +116,7 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
             .snapshot(1)?
             .with_context(|| format!("{}: no snapshot at t1", rec.display()))?;
         let measured = flow::measure(&t1, omega, r.case.drum.radius);
-        let diameter = 2.0 * t1.radius.iter().sum::<f64>() / t1.len().max(1) as f64;
+        let diameter = t1.mean_diameter();
         let refused = refusal(
             r.rotation_period,
             omega,
@@ -168,9 +167,7 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
         min_relative,
         runs: entries,
     };
-    let json = serde_json::to_string_pretty(&study)?;
-    let table = table(&study);
-    let mut files = vec![write_file(dir, "study.json", &json)?];
+    let mut svgs: Vec<(&str, String)> = Vec::new();
     let points: Vec<(f64, f64, String)> = study
         .runs
         .iter()
@@ -182,19 +179,17 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
             ))
         })
         .collect();
-    files.push(write_file(
-        dir,
+    svgs.push((
         "error_vs_froude.svg",
-        &plots::scatter(
+        plots::scatter(
             "Maximum ε_rel against the Froude number",
             "log10 Froude number ω²R/g",
             "max ε_rel over the t_k (%)",
             &points,
         )?,
-    )?);
-    files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    super::print_outcome(plan.json, &json, &table, &files);
-    Ok(())
+    ));
+    let table = table(&study);
+    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
 }
 
 fn table(s: &RegimesStudy) -> String {

@@ -2,7 +2,7 @@
 //! the period, the K-period reference) feeds one sampler per (n, Δt_c^max); each recording
 //! is extrapolated K periods and compared with the shared reference.
 
-use super::{evaluate, num, pct, plots, run_paths, write_file, Outcome};
+use super::{evaluate, num, pct, plots, run_paths, Outcome};
 use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
 use recorder::record::{self, RecordJob, RecordOptions};
@@ -67,9 +67,6 @@ pub fn run(
         .map(|o| format!("n{}_dtc{}", o.sample_every, o.dtc_max_steps))
         .collect();
     let paths: Vec<_> = stems.iter().map(|s| run_paths(dir, s)).collect();
-    for (rec, _) in &paths {
-        let _ = std::fs::remove_file(crate::pair::sidecar(rec));
-    }
     say(format!(
         "record        {} combinations of (n, Δt_c^max) from one DEM run: τ = {} s ({} steps), \
          then {periods} reference periods",
@@ -141,9 +138,7 @@ pub fn run(
             .collect(),
         grid,
     };
-    let json = serde_json::to_string_pretty(&study)?;
-    let table = table(&study);
-    let mut files = vec![write_file(dir, "study.json", &json)?];
+    let mut svgs: Vec<(&str, String)> = Vec::new();
     let label = |e: &Entry| format!("n{}/{}", e.n, e.dtc_max_steps);
     let size: Vec<(f64, f64, String)> = study
         .grid
@@ -167,20 +162,18 @@ pub fn run(
             ))
         })
         .collect();
-    files.push(write_file(
-        dir,
+    svgs.push((
         "error_vs_table_size.svg",
-        &plots::scatter(
+        plots::scatter(
             "Maximum ε_rel against the collision table's size",
             "table size (MB)",
             "max ε_rel over the t_k (%)",
             &size,
         )?,
-    )?);
-    files.push(write_file(
-        dir,
+    ));
+    svgs.push((
         "error_vs_speedup.svg",
-        &plots::scatter(
+        plots::scatter(
             &format!(
                 "Maximum ε_rel against the speedup for {} τ",
                 super::TABLE_PERIODS
@@ -189,10 +182,9 @@ pub fn run(
             "max ε_rel over the t_k (%)",
             &speed,
         )?,
-    )?);
-    files.push(write_file(dir, "study.md", &markdown(&study, &table))?);
-    super::print_outcome(plan.json, &json, &table, &files);
-    Ok(())
+    ));
+    let table = table(&study);
+    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
 }
 
 fn table(s: &SamplingStudy) -> String {

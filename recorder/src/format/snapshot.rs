@@ -46,6 +46,11 @@ impl Snapshot {
         self.id.is_empty()
     }
 
+    /// Mean particle diameter (m); 0 for an empty snapshot.
+    pub fn mean_diameter(&self) -> f64 {
+        2.0 * self.radius.iter().sum::<f64>() / self.len().max(1) as f64
+    }
+
     /// The snapshot as an encoded `foxglove.PointCloud`.
     pub fn encode(&self) -> Vec<u8> {
         let mut data = Vec::with_capacity(self.len() * POINT_STRIDE);
