@@ -35,6 +35,7 @@ fn main() -> ExitCode {
         cli::Plan::Run(p) => run::run(&p),
         cli::Plan::Record(p) => record::run(&p),
         cli::Plan::Inspect(p) => inspect::run(&p),
+        cli::Plan::Bench(p) => bench::engine(&p),
         cli::Plan::BenchRecord(p) => bench::record(&p),
         cli::Plan::Pair(p) => pair::run(&p),
         cli::Plan::Extrapolate(p) => extrapolation::run(&p),

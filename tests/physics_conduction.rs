@@ -25,7 +25,7 @@ fn pair_temperature_difference_decays_exponentially() {
     let mut world = World::new(p, no_walls(), 0.5, dt, 0.0);
     world
         .neighbors
-        .rebuild(&mut world.particles, &world.pipeline.grid);
+        .rebuild(&mut world.particles, &world.pipeline.grid, &world.walls);
     let (a, b) = if world.particles.id[0] == 0 {
         (0, 1)
     } else {

@@ -57,7 +57,7 @@ impl World {
         let rmax = particles.radius.iter().cloned().fold(0.0, f64::max);
         let skin = 0.4 * rmax;
         let grid = CellGrid::new([-0.1; 3], [0.1; 3], 2.0 * rmax + skin);
-        let neighbors = NeighborList::new(particles.len(), walls.len(), skin);
+        let neighbors = NeighborList::new(skin);
         Self {
             params,
             particles,

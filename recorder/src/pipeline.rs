@@ -12,8 +12,8 @@ use crate::particles::ParticleSet;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
-/// Particles per parallel task in the interaction stages.
-const BLOCK: usize = 256;
+/// Particles per parallel task in the wall stage.
+const BLOCK: usize = 1024;
 
 /// Everything constant during a step.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,7 +58,7 @@ impl Pipeline {
         });
         timed(&mut counters.neighbor, || {
             if neighbors.needs_rebuild(particles) {
-                neighbors.rebuild(particles, &self.grid);
+                neighbors.rebuild(particles, &self.grid, walls);
             }
         });
         let pair_entries = timed(&mut counters.pair, || {
@@ -77,7 +77,8 @@ impl Pipeline {
     }
 }
 
-/// Splits `items` into consecutive mutable pieces, piece `b` covering `bounds[b]..bounds[b+1]`.
+/// Splits `items` into consecutive mutable pieces, piece `b` covering `bounds[b]..bounds[b+1]`
+/// (bounds increasing and not overlapping; gaps are skipped).
 fn split_by<T>(mut items: &mut [T], bounds: impl Iterator<Item = (usize, usize)>) -> Vec<&mut [T]> {
     let mut pieces = Vec::new();
     let mut at = 0;
@@ -91,24 +92,27 @@ fn split_by<T>(mut items: &mut [T], bounds: impl Iterator<Item = (usize, usize)>
     pieces
 }
 
-/// Runs `work` on every block, in parallel when there is more than one.
-fn for_each_block<T: Send>(blocks: Vec<T>, work: impl Fn(T) -> u64 + Sync + Send) -> u64 {
-    if blocks.len() == 1 {
-        blocks.into_iter().map(work).sum()
+/// Runs `work` on every task, in parallel when there is more than one.
+fn for_each_task<T: Send>(tasks: Vec<T>, work: impl Fn(T) -> u64 + Sync + Send) -> u64 {
+    if tasks.len() <= 1 {
+        tasks.into_iter().map(work).sum()
     } else {
-        blocks.into_par_iter().map(work).sum()
+        tasks.into_par_iter().map(work).sum()
     }
 }
 
-/// Sphere–sphere forces, torques and conduction. Every particle sums over its own full
-/// neighbour list and writes only its own entries: no write conflicts, thread-count
-/// independent. Returns the number of touching entries.
+/// Sphere–sphere forces, torques and conduction, each pair evaluated once from the half list.
+///
+/// Layer `l` of the cell grid owns the pairs of its particles, whose partners lie in layer
+/// `l` or `l + 1`, so it writes only those two layers. The even layers run in parallel, then
+/// the odd ones: no two tasks write the same particle, and every particle receives its
+/// contributions in an order fixed by the list alone, so the sums do not depend on the
+/// thread count. Returns the touching pairs counted from both sides.
 pub fn pair_interactions(
     params: &StepParams,
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
 ) -> u64 {
-    let n = particles.len();
     let ParticleSet {
         pos,
         vel,
@@ -122,23 +126,27 @@ pub fn pair_interactions(
         ..
     } = particles;
     let (pos, vel, omega, radius, mass, temp) = (&*pos, &*vel, &*omega, &*radius, &*mass, &*temp);
-    let offsets = &neighbors.offsets;
-    let nbrs = &neighbors.neighbors;
-    let block_bounds = (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
-    let entry_bounds = || {
-        block_bounds
-            .clone()
-            .map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize))
-    };
-    let history = split_by(&mut neighbors.history, entry_bounds());
-    let areas = split_by(&mut neighbors.sqrt_area, entry_bounds());
-    let blocks: Vec<_> = force
-        .chunks_mut(BLOCK)
-        .zip(torque.chunks_mut(BLOCK))
-        .zip(heat_flow.chunks_mut(BLOCK))
-        .zip(history.into_iter().zip(areas))
-        .enumerate()
-        .collect();
+    force
+        .par_iter_mut()
+        .with_min_len(4096)
+        .for_each(|f| *f = [0.0; 3]);
+    torque
+        .par_iter_mut()
+        .with_min_len(4096)
+        .for_each(|t| *t = [0.0; 3]);
+    heat_flow
+        .par_iter_mut()
+        .with_min_len(4096)
+        .for_each(|q| *q = 0.0);
+    let NeighborList {
+        offsets,
+        neighbors: partners,
+        history,
+        touching,
+        layer_start,
+        ..
+    } = neighbors;
+    let layers = layer_start.len().saturating_sub(1);
     let state = |i: usize| SphereState {
         pos: pos[i],
         vel: vel[i],
@@ -148,58 +156,86 @@ pub fn pair_interactions(
     };
     let dt = params.dt;
     let (law, heat) = (&params.particle_particle, &params.conduction);
-    for_each_block(
-        blocks,
-        |(b, (((f_block, t_block), q_block), (h_block, a_block)))| {
-            let lo = b * BLOCK;
-            let base = offsets[lo] as usize;
-            let mut touching = 0;
-            for (k, ((f_out, t_out), q_out)) in f_block
-                .iter_mut()
-                .zip(t_block.iter_mut())
-                .zip(q_block.iter_mut())
-                .enumerate()
-            {
-                let i = lo + k;
+    let mut pairs = 0;
+    for phase in 0..2 {
+        let owned = (phase..layers).step_by(2);
+        // slots a task writes (its layer and the next) and entries it owns (its layer's)
+        let slots = owned.clone().map(|l| {
+            (
+                layer_start[l] as usize,
+                layer_start[(l + 2).min(layers)] as usize,
+            )
+        });
+        let entries = owned.clone().map(|l| {
+            (
+                offsets[layer_start[l] as usize] as usize,
+                offsets[layer_start[l + 1] as usize] as usize,
+            )
+        });
+        let tasks: Vec<_> = owned
+            .zip(split_by(force, slots.clone()))
+            .zip(split_by(torque, slots.clone()))
+            .zip(split_by(heat_flow, slots))
+            .zip(
+                split_by(history, entries.clone())
+                    .into_iter()
+                    .zip(split_by(touching, entries)),
+            )
+            .collect();
+        pairs += for_each_task(tasks, |((((l, f), t), q), (h, touch))| {
+            let first_slot = layer_start[l] as usize;
+            let first_entry = offsets[first_slot] as usize;
+            let mut touching_pairs = 0;
+            for i in first_slot..layer_start[l + 1] as usize {
                 let si = state(i);
-                let (mut f, mut t, mut q) = ([0.0; 3], [0.0; 3], 0.0);
+                let (mut fi, mut ti, mut qi) = ([0.0; 3], [0.0; 3], 0.0);
                 for e in offsets[i] as usize..offsets[i + 1] as usize {
-                    let j = nbrs[e] as usize;
-                    let h: &mut ContactHistory = &mut h_block[e - base];
-                    match sphere_sphere::kinematics(&si, &state(j)) {
-                        Some((kin, r)) => {
-                            let resp = hertz_mindlin::respond(law, &kin, h, dt);
-                            f = add(f, resp.force);
-                            t = add(t, resp.torque);
-                            let sqrt_area = heat.pair_area(r, si.radius, radius[j]).sqrt();
-                            q += heat.pair_conductivity * sqrt_area * (temp[j] - temp[i]);
-                            a_block[e - base] = sqrt_area;
-                            touching += 1;
+                    let j = partners[e] as usize;
+                    let delta = sub(si.pos, pos[j]);
+                    let local = e - first_entry;
+                    let Some(r2) = sphere_sphere::overlapping(delta, si.radius, radius[j]) else {
+                        if touch[local] {
+                            h[local] = ContactHistory::default();
+                            touch[local] = false;
                         }
-                        None => {
-                            *h = ContactHistory::default();
-                            a_block[e - base] = 0.0;
-                        }
-                    }
+                        continue;
+                    };
+                    let c = sphere_sphere::kinematics(&si, &state(j), delta, r2);
+                    let resp = hertz_mindlin::respond(law, &c.kinematics, &mut h[local], dt);
+                    touch[local] = true;
+                    let jl = j - first_slot;
+                    fi = add(fi, resp.force);
+                    f[jl] = sub(f[jl], resp.force);
+                    ti = add(ti, resp.torque_on_i(c.lever_i));
+                    t[jl] = add(t[jl], resp.torque_on_partner(c.lever_j));
+                    let conductance = heat.pair_conductivity
+                        * heat.pair_area(c.distance, si.radius, radius[j]).sqrt();
+                    let flow = conductance * (temp[j] - temp[i]);
+                    qi += flow;
+                    q[jl] -= flow;
+                    touching_pairs += 1;
                 }
-                *f_out = f;
-                *t_out = t;
-                *q_out = q;
+                let il = i - first_slot;
+                f[il] = add(f[il], fi);
+                t[il] = add(t[il], ti);
+                q[il] += qi;
             }
-            touching
-        },
-    )
+            touching_pairs
+        });
+    }
+    2 * pairs
 }
 
-/// Sphere–wall forces and heated-wall conduction, added to the pair results.
+/// Sphere–wall forces and heated-wall conduction over the wall candidates of the list,
+/// added to the pair results (each particle writes only its own sums).
 pub fn wall_interactions(
     params: &StepParams,
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
     walls: &WallSet,
 ) -> u64 {
-    let nw = walls.len();
-    if nw == 0 {
+    let n = particles.len();
+    if walls.is_empty() || n == 0 {
         return 0;
     }
     let ParticleSet {
@@ -215,42 +251,63 @@ pub fn wall_interactions(
         ..
     } = particles;
     let (pos, vel, omega, radius, mass, temp) = (&*pos, &*vel, &*omega, &*radius, &*mass, &*temp);
-    let blocks: Vec<_> = force
+    let NeighborList {
+        wall_offsets,
+        wall_index,
+        wall_history,
+        wall_touching,
+        ..
+    } = neighbors;
+    let wall_offsets = &*wall_offsets;
+    let wall_index = &*wall_index;
+    let block_bounds = (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
+    let entry_bounds = block_bounds
+        .clone()
+        .map(|(lo, hi)| (wall_offsets[lo] as usize, wall_offsets[hi] as usize));
+    let tasks: Vec<_> = force
         .chunks_mut(BLOCK)
         .zip(torque.chunks_mut(BLOCK))
         .zip(heat_flow.chunks_mut(BLOCK))
-        .zip(neighbors.wall_history.chunks_mut(BLOCK * nw))
+        .zip(
+            split_by(wall_history, entry_bounds.clone())
+                .into_iter()
+                .zip(split_by(wall_touching, entry_bounds)),
+        )
         .enumerate()
         .collect();
     let dt = params.dt;
     let (law, heat) = (&params.particle_wall, &params.conduction);
-    for_each_block(blocks, |(b, (((f_block, t_block), q_block), h_block))| {
+    for_each_task(tasks, |(b, (((f, t), q), (h, touch)))| {
+        let first_slot = b * BLOCK;
+        let first_entry = wall_offsets[first_slot] as usize;
         let mut touching = 0;
-        for k in 0..f_block.len() {
-            let i = b * BLOCK + k;
-            let si = SphereState {
-                pos: pos[i],
-                vel: vel[i],
-                omega: omega[i],
-                radius: radius[i],
-                mass: mass[i],
-            };
-            for w in 0..nw {
-                let h = &mut h_block[k * nw + w];
-                match walls.contact(w, si.pos, si.radius) {
-                    Some(c) => {
-                        let kin = sphere_wall::kinematics(&si, &c);
-                        let resp = hertz_mindlin::respond(law, &kin, h, dt);
-                        f_block[k] = add(f_block[k], resp.force);
-                        t_block[k] = add(t_block[k], resp.torque);
-                        if let Some(tw) = walls.temperature(w) {
-                            q_block[k] +=
-                                heat.wall_conductance(c.overlap, si.radius) * (tw - temp[i]);
-                        }
-                        touching += 1;
+        for il in 0..f.len() {
+            let i = first_slot + il;
+            for e in wall_offsets[i] as usize..wall_offsets[i + 1] as usize {
+                let (w, local) = (wall_index[e] as usize, e - first_entry);
+                let Some(c) = walls.contact(w, pos[i], radius[i]) else {
+                    if touch[local] {
+                        h[local] = ContactHistory::default();
+                        touch[local] = false;
                     }
-                    None => *h = ContactHistory::default(),
+                    continue;
+                };
+                let si = SphereState {
+                    pos: pos[i],
+                    vel: vel[i],
+                    omega: omega[i],
+                    radius: radius[i],
+                    mass: mass[i],
+                };
+                let (kin, lever) = sphere_wall::kinematics(&si, &c);
+                let resp = hertz_mindlin::respond(law, &kin, &mut h[local], dt);
+                touch[local] = true;
+                f[il] = add(f[il], resp.force);
+                t[il] = add(t[il], resp.torque_on_i(lever));
+                if let Some(tw) = walls.temperature(w) {
+                    q[il] += heat.wall_conductance(c.overlap, si.radius) * (tw - temp[i]);
                 }
+                touching += 1;
             }
         }
         touching

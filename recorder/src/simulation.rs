@@ -7,6 +7,7 @@ use crate::counters::Counters;
 use crate::format::Snapshot;
 use crate::heat::ConductionLaw;
 use crate::insertion;
+use crate::math::{norm2, sub};
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::pipeline::{ContactCount, Pipeline, StepParams};
@@ -119,7 +120,7 @@ impl Simulation {
         Ok(Self {
             case: case.clone(),
             params,
-            neighbors: NeighborList::new(particles.len(), walls.len(), skin),
+            neighbors: NeighborList::new(skin),
             particles,
             walls,
             pipeline: Pipeline::new(grid),
@@ -269,14 +270,19 @@ impl Simulation {
     }
 
     /// Pairs touching at the last step, each once, in the order the DEM lists them:
-    /// `(id_a, id_b, sqrt(contact area))` — the recorder's sample.
+    /// `(smaller id, larger id, sqrt(contact area))` — the recorder's sample. The area is
+    /// recomputed from the positions the pair stage used (the last half kick moves none), by
+    /// the same expressions, so it is the conducted area to the bit.
     pub fn touching_pairs(&self) -> impl Iterator<Item = (u32, u32, f64)> + '_ {
-        let (list, ids) = (&self.neighbors, &self.particles.id);
-        (0..self.particles.len()).flat_map(move |i| {
-            list.range(i).filter_map(move |e| {
+        let (list, p) = (&self.neighbors, &self.particles);
+        let heat = &self.params.conduction;
+        (0..p.len()).flat_map(move |i| {
+            list.range(i).filter(|&e| list.touching[e]).map(move |e| {
                 let j = list.neighbors[e] as usize;
-                let a = list.sqrt_area[e];
-                (a > 0.0 && ids[i] < ids[j]).then_some((ids[i], ids[j], a))
+                let r = norm2(sub(p.pos[i], p.pos[j])).sqrt();
+                let sqrt_area = heat.pair_area(r, p.radius[i], p.radius[j]).sqrt();
+                let (a, b) = (p.id[i].min(p.id[j]), p.id[i].max(p.id[j]));
+                (a, b, sqrt_area)
             })
         })
     }

@@ -144,9 +144,10 @@ pub enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
-    /// Benchmarks (figures for docs/benchmarks.md).
-    #[command(subcommand)]
-    Bench(BenchCommand),
+    /// Benchmarks (figures for docs/benchmarks.md): `tdex bench CASE` times the DEM engine
+    /// on the rotating, heated phase of a case (optionally against LIGGGHTS in the same run);
+    /// `tdex bench record CASE` the recording overhead.
+    Bench(BenchArgs),
     /// Parameter studies (Haydar §3.2–3.3): sampling (n, Δt_c^max), pairing period τ, and
     /// flow regimes (drum speed), each recorded, extrapolated and compared with the DEM.
     #[command(subcommand)]
@@ -160,6 +161,34 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+}
+
+/// `tdex bench CASE [...]` or `tdex bench record CASE [...]`.
+#[derive(Debug, clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct BenchArgs {
+    #[command(subcommand)]
+    pub command: Option<BenchCommand>,
+    /// The case file (TOML): it is run to t0 (settle, spin-up), then the heated, rotating
+    /// phase is timed.
+    #[arg(required = true)]
+    pub case: Option<PathBuf>,
+    /// DEM steps to time after t0.
+    #[arg(long, default_value_t = 5000)]
+    pub steps: u64,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Also run the same case in LIGGGHTS 3.8 (`liggghts` on PATH, one process) for the same
+    /// steps and print both rates and their ratio.
+    #[arg(long = "vs-liggghts")]
+    pub vs_liggghts: bool,
+    /// Where the LIGGGHTS deck, mesh and log are written (default: a new temporary directory).
+    #[arg(long = "liggghts-dir", requires = "vs_liggghts")]
+    pub liggghts_dir: Option<PathBuf>,
+    /// Print the result as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Subcommand)]

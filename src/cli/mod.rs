@@ -6,6 +6,6 @@ mod plan;
 pub use args::Cli;
 pub(crate) use plan::record_options;
 pub use plan::{
-    BenchRecordPlan, ComparePlan, DemoPlan, ExtrapolatePlan, InspectPlan, PairPlan, Plan,
-    RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan, UsageError,
+    BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExtrapolatePlan, InspectPlan, PairPlan,
+    Plan, RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan, UsageError,
 };

@@ -1,6 +1,6 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
-use super::args::{BenchCommand, Cli, Command, StudyCommand, StudyCommon};
+use super::args::{BenchArgs, BenchCommand, Cli, Command, StudyCommand, StudyCommon};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::format::AreaEncoding;
@@ -25,6 +25,7 @@ pub enum Plan {
     Run(RunPlan),
     Record(RecordPlan),
     Inspect(InspectPlan),
+    Bench(BenchPlan),
     BenchRecord(BenchRecordPlan),
     Pair(PairPlan),
     Extrapolate(ExtrapolatePlan),
@@ -109,6 +110,18 @@ pub struct ExtrapolatePlan {
     pub scheme: Scheme,
     pub stream: bool,
     pub threads: usize,
+    pub json: bool,
+}
+
+/// `tdex bench CASE`: engine throughput on the heated phase, optionally against LIGGGHTS.
+pub struct BenchPlan {
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub steps: u64,
+    pub threads: usize,
+    /// `Some(dir)`: run the LIGGGHTS peer there (`None` inside: a temporary directory).
+    pub liggghts: Option<Option<PathBuf>>,
     pub json: bool,
 }
 
@@ -276,14 +289,48 @@ impl Plan {
                 Ok(Plan::Demo(DemoPlan { output, threads }))
             }
             Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
-            Command::Bench(BenchCommand::Record {
-                case,
-                tau_rev,
-                n,
-                dtc_max,
-                repeats,
+            Command::Bench(BenchArgs {
+                command: None,
+                case: Some(case),
+                steps,
                 threads: t,
+                vs_liggghts,
+                liggghts_dir,
                 json,
+            }) => {
+                let threads = threads(t)?;
+                if steps == 0 {
+                    return Err(usage("--steps = 0 is not allowed: give at least 1".into()));
+                }
+                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
+                if let Some(dir) = &liggghts_dir {
+                    check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
+                }
+                Ok(Plan::Bench(BenchPlan {
+                    case_path: case,
+                    case_toml,
+                    case: loaded,
+                    steps,
+                    threads,
+                    liggghts: vs_liggghts.then_some(liggghts_dir),
+                    json,
+                }))
+            }
+            Command::Bench(BenchArgs { command: None, case: None, .. }) => Err(usage(
+                "tdex bench needs a case file (tdex bench CASE) or a subcommand (tdex bench record CASE)".into(),
+            )),
+            Command::Bench(BenchArgs {
+                command:
+                    Some(BenchCommand::Record {
+                        case,
+                        tau_rev,
+                        n,
+                        dtc_max,
+                        repeats,
+                        threads: t,
+                        json,
+                    }),
+                ..
             }) => {
                 let threads = threads(t)?;
                 if repeats == 0 {
@@ -411,9 +458,14 @@ fn check_cells(cells: usize) -> Result<()> {
 
 /// A report directory: an existing directory, or a new one whose parent exists.
 fn check_output_dir(dir: &std::path::Path) -> Result<()> {
+    check_dir("-o", dir, "the output")
+}
+
+/// `dir` (given with `flag`) is a directory or can be created as one; `what` goes in it.
+fn check_dir(flag: &str, dir: &std::path::Path, what: &str) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(usage(format!(
-            "-o {}: is a file; give a directory for the report",
+            "{flag} {}: is a file; give a directory for {what}",
             dir.display()
         )));
     }

@@ -1,4 +1,4 @@
-//! Contact kinematics of two spheres (LIGGGHTS `surface_model_default`).
+//! Contact kinematics of two spheres (LIGGGHTS `surface_model_default`), evaluated once per pair.
 
 use super::hertz_mindlin::ContactKinematics;
 use crate::math::*;
@@ -13,31 +13,47 @@ pub struct SphereState {
     pub mass: f64,
 }
 
-/// Kinematics of `i` against `j` and their centre distance, or `None` if they do not touch.
+/// A touching pair seen from `i`: the law's kinematics, the centre distance and both
+/// contact lever arms `R − δ/2`.
+#[derive(Debug, Clone, Copy)]
+pub struct PairContact {
+    pub kinematics: ContactKinematics,
+    pub distance: f64,
+    pub lever_i: f64,
+    pub lever_j: f64,
+}
+
+/// Whether spheres of radii `ri`, `rj` whose centres are `delta` apart overlap; the squared
+/// distance alongside (the broad test, before any other field of `j` is read).
 #[inline(always)]
-pub fn kinematics(i: &SphereState, j: &SphereState) -> Option<(ContactKinematics, f64)> {
-    let delta = sub(i.pos, j.pos);
+pub fn overlapping(delta: Vec3, ri: f64, rj: f64) -> Option<f64> {
     let r2 = norm2(delta);
+    let radsum = ri + rj;
+    (r2 < radsum * radsum).then_some(r2)
+}
+
+/// Kinematics of `i` against `j`, given `delta = x_i − x_j` and its squared length `r2`
+/// from [`overlapping`].
+#[inline(always)]
+pub fn kinematics(i: &SphereState, j: &SphereState, delta: Vec3, r2: f64) -> PairContact {
     let radsum = i.radius + j.radius;
-    if r2 >= radsum * radsum {
-        return None;
-    }
     let r = r2.sqrt();
     let overlap = radsum - r;
     let normal = scale(delta, 1.0 / r);
     let lever_i = i.radius - 0.5 * overlap;
     let lever_j = j.radius - 0.5 * overlap;
-    Some((
-        ContactKinematics {
+    PairContact {
+        kinematics: ContactKinematics {
             overlap,
             normal,
             rel_vel: sub(i.vel, j.vel),
             lever_omega: add(scale(i.omega, lever_i), scale(j.omega, lever_j)),
             roll_omega: sub(i.omega, j.omega),
-            lever_i,
             r_eff: i.radius * j.radius / radsum,
             m_eff: i.mass * j.mass / (i.mass + j.mass),
         },
-        r,
-    ))
+        distance: r,
+        lever_i,
+        lever_j,
+    }
 }

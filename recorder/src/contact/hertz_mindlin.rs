@@ -19,6 +19,10 @@ pub struct PairLaw {
     /// Rolling coefficient μr.
     pub rolling_friction: f64,
     pub rolling_model: RollingModel,
+    /// `damping_factor · sqrt(2 E*)`: γn = this · sqrt(s m*) with `s = sqrt(R* δ)`.
+    normal_damping: f64,
+    /// `damping_factor · sqrt(8 G*)`: γt = this · sqrt(s m*).
+    tangential_damping: f64,
 }
 
 impl PairLaw {
@@ -34,13 +38,17 @@ impl PairLaw {
         let inv_g_star = 2.0 * (2.0 * (2.0 - nu) * (1.0 + nu) / e);
         let ln_e = c.restitution.ln();
         let beta = ln_e / (ln_e * ln_e + std::f64::consts::PI * std::f64::consts::PI).sqrt();
+        let (e_star, g_star) = (1.0 / inv_e_star, 1.0 / inv_g_star);
+        let damping_factor = -2.0 * (5.0f64 / 6.0).sqrt() * beta;
         Self {
-            e_star: 1.0 / inv_e_star,
-            g_star: 1.0 / inv_g_star,
-            damping_factor: -2.0 * (5.0f64 / 6.0).sqrt() * beta,
+            e_star,
+            g_star,
+            damping_factor,
             friction: c.friction,
             rolling_friction: c.rolling_friction,
             rolling_model,
+            normal_damping: damping_factor * (2.0 * e_star).sqrt(),
+            tangential_damping: damping_factor * (8.0 * g_star).sqrt(),
         }
     }
 }
@@ -58,8 +66,6 @@ pub struct ContactKinematics {
     pub lever_omega: Vec3,
     /// Relative angular velocity for rolling resistance.
     pub roll_omega: Vec3,
-    /// Contact lever arm of `i`, `R_i − δ/2`.
-    pub lever_i: f64,
     /// R* (walls: R_i).
     pub r_eff: f64,
     /// m* (walls: m_i).
@@ -67,23 +73,52 @@ pub struct ContactKinematics {
 }
 
 /// Tangential and rolling springs carried from step to step; zero while the contact is open.
+/// Seen from the partner the same springs are the negated ones.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ContactHistory {
     pub shear: Vec3,
     pub roll: Vec3,
 }
 
-/// Force and torque on `i`, and the normal force magnitude (for the recorder and diagnostics).
+impl ContactHistory {
+    /// The same springs seen from the other body of the pair.
+    pub fn reversed(self) -> Self {
+        Self {
+            shear: scale(self.shear, -1.0),
+            roll: scale(self.roll, -1.0),
+        }
+    }
+}
+
+/// Force on `i` and the two parts of the torques; the partner gets `−force`.
 #[derive(Debug, Clone, Copy)]
 pub struct ContactResponse {
     pub force: Vec3,
-    pub torque: Vec3,
+    /// `n × Ft`: a body whose contact lever arm is `c` gets `−c (n × Ft)` from it (the
+    /// partner sees `−n` and `−Ft`, so the same product).
+    pub moment_arm_torque: Vec3,
+    /// The rolling-resistance torque `M`: `−M` on `i`, `+M` on the partner.
+    pub rolling_torque: Vec3,
+    /// Normal force magnitude (positive in compression).
     pub normal_force: f64,
 }
 
-/// Evaluates the law for `i`, advancing the history by `dt`. Written so that evaluating the
-/// same pair from `j` gives exactly the opposite force and history (bitwise), which keeps the
-/// full-neighbour-list sums symmetric.
+impl ContactResponse {
+    /// Torque on `i`, whose lever arm is `lever_i = R_i − δ/2`.
+    #[inline(always)]
+    pub fn torque_on_i(&self, lever_i: f64) -> Vec3 {
+        sub(scale(self.moment_arm_torque, -lever_i), self.rolling_torque)
+    }
+
+    /// Torque on the partner sphere, whose lever arm is `lever_j = R_j − δ/2`.
+    #[inline(always)]
+    pub fn torque_on_partner(&self, lever_j: f64) -> Vec3 {
+        add(scale(self.moment_arm_torque, -lever_j), self.rolling_torque)
+    }
+}
+
+/// Evaluates the law for `i`, advancing the history by `dt`. Each pair is evaluated once;
+/// the partner gets the opposite force and history.
 #[inline(always)]
 pub fn respond(
     law: &PairLaw,
@@ -99,35 +134,33 @@ pub fn respond(
     let s = (k.r_eff * k.overlap).sqrt();
     let kn = 4.0 / 3.0 * law.e_star * s;
     let kt = 8.0 * law.g_star * s;
-    let gamma_n = law.damping_factor * (2.0 * law.e_star * s * k.m_eff).sqrt();
-    let gamma_t = law.damping_factor * (kt * k.m_eff).sqrt();
+    // γn = d sqrt(2 E* s m*) and γt = d sqrt(kt m*) share the root sqrt(s m*)
+    let root_sm = (s * k.m_eff).sqrt();
+    let gamma_n = law.normal_damping * root_sm;
+    let gamma_t = law.tangential_damping * root_sm;
     // LIGGGHTS leaves limitForce off: the force may turn slightly attractive as the pair separates
     let fn_mag = kn * k.overlap - gamma_n * vn;
 
     let mut shear = add(history.shear, scale(slip, dt));
     shear = tangential(shear, en);
     let mut ft = scale(shear, -kt);
-    let ft_spring = kt * norm2(shear).sqrt();
+    let ft_spring2 = kt * kt * norm2(shear);
     let ft_max = law.friction * fn_mag.abs();
-    if ft_spring > ft_max {
-        if ft_spring > 0.0 {
-            ft = scale(ft, ft_max / ft_spring);
-            shear = scale(ft, -1.0 / kt);
-        } else {
-            ft = [0.0; 3];
-        }
+    // squares compared: the root is only needed when the contact slides
+    if ft_spring2 > ft_max * ft_max {
+        let ft_spring = ft_spring2.sqrt();
+        ft = scale(ft, ft_max / ft_spring);
+        shear = scale(ft, -1.0 / kt);
     } else {
         ft = sub(ft, scale(slip, gamma_t));
     }
     history.shear = shear;
 
-    let mut torque = scale(cross(en, ft), -k.lever_i);
-    let roll_torque = rolling::torque(law, k, kn, kt, fn_mag, &mut history.roll, dt);
-    torque = sub(torque, roll_torque);
-
+    let rolling_torque = rolling::torque(law, k, kn, kt, fn_mag, &mut history.roll, dt);
     ContactResponse {
         force: add(scale(en, fn_mag), ft),
-        torque,
+        moment_arm_torque: cross(en, ft),
+        rolling_torque,
         normal_force: fn_mag,
     }
 }

@@ -22,10 +22,11 @@ pub fn torque(
             let wr_t = tangential(k.roll_omega, k.normal);
             let kr = kt * k.r_eff * k.r_eff;
             let mut m = add(*spring, scale(wr_t, dt * kr));
-            let m_mag = norm2(m).sqrt();
             let m_max = fn_mag.abs() * k.r_eff * law.rolling_friction;
-            if m_mag > m_max {
-                m = scale(m, m_max / m_mag);
+            let m_mag2 = norm2(m);
+            // squares compared: the root is only needed when the spring is capped
+            if m_mag2 > m_max * m_max {
+                m = scale(m, m_max / m_mag2.sqrt());
             }
             *spring = m;
             m

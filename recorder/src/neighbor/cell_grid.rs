@@ -1,5 +1,7 @@
 //! A uniform grid of cubic cells over a fixed box; positions outside are clamped to the edge
-//! cells, which keeps every pair closer than a cell size in adjacent cells.
+//! cells, which keeps every pair closer than a cell size in adjacent cells. Cells are numbered
+//! layer by layer along the axis with the most cells, so that slot order (cells in index
+//! order) puts every half-list partner in the particle's own layer or the next one.
 
 use crate::math::Vec3;
 
@@ -8,6 +10,8 @@ pub struct CellGrid {
     pub origin: Vec3,
     pub cell_size: f64,
     pub dims: [usize; 3],
+    /// Axes from the fastest-varying index to the slowest (the layer axis).
+    axes: [usize; 3],
 }
 
 impl CellGrid {
@@ -17,16 +21,30 @@ impl CellGrid {
         for k in 0..3 {
             dims[k] = (((hi[k] - lo[k]) / min_cell).floor() as usize).max(1);
         }
+        // the longest axis is the layer axis: the most layers, the most parallel tasks
+        let mut axes = [0, 1, 2];
+        axes.sort_by_key(|&k| (dims[k], k));
         // cells stay ≥ min_cell: the box is widened to a whole number of them
         Self {
             origin: lo,
             cell_size: min_cell,
             dims,
+            axes,
         }
     }
 
     pub fn cell_count(&self) -> usize {
         self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    /// Number of layers (cells along the layer axis).
+    pub fn layers(&self) -> usize {
+        self.dims[self.axes[2]]
+    }
+
+    /// Cells in one layer: layer `l` holds cells `l * cells_per_layer ..`.
+    pub fn cells_per_layer(&self) -> usize {
+        self.dims[self.axes[0]] * self.dims[self.axes[1]]
     }
 
     /// Integer cell coordinates of a position, clamped to the grid.
@@ -41,9 +59,30 @@ impl CellGrid {
         c
     }
 
-    /// Linear cell index, x fastest.
+    /// Linear cell index, layer axis slowest.
     #[inline(always)]
     pub fn index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.dims[1] + c[1]) * self.dims[0] + c[0]
+        let [a, b, l] = self.axes;
+        (c[l] * self.dims[b] + c[b]) * self.dims[a] + c[a]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_longest_axis_is_the_layer_axis() {
+        let grid = CellGrid::new([0.0; 3], [2.0, 10.0, 3.0], 1.0);
+        assert_eq!(grid.dims, [2, 10, 3]);
+        assert_eq!(grid.layers(), 10);
+        assert_eq!(grid.cells_per_layer(), 6);
+        // every cell of layer y = 4 lies in 24..30
+        for x in 0..2 {
+            for z in 0..3 {
+                let i = grid.index([x, 4, z]);
+                assert!((24..30).contains(&i), "{i}");
+            }
+        }
     }
 }

@@ -1,11 +1,13 @@
-//! The full (both-direction) Verlet list in CSR form. On rebuild the particles are re-sorted
-//! in cell order (memory order is worth several times in the force loop) and every open
-//! contact's history follows its pair into the new list.
+//! The half Verlet list in CSR form (each pair once, partner after the particle in slot
+//! order) and the wall candidates, with every contact's history stored next to its entry.
+//! On rebuild the particles are re-sorted in cell order (memory order is worth several times
+//! in the force loop) and every open contact's history follows its pair into the new list.
 
 use super::CellGrid;
 use crate::contact::ContactHistory;
 use crate::math::*;
-use crate::particles::{permute_field, ParticleSet};
+use crate::particles::ParticleSet;
+use crate::wall::WallSet;
 use rayon::prelude::*;
 
 /// Particles per parallel task in the list build.
@@ -15,16 +17,20 @@ const BLOCK: usize = 512;
 pub struct NeighborList {
     /// Entries of slot `i` are `offsets[i]..offsets[i + 1]`.
     pub offsets: Vec<u32>,
-    /// Neighbour slots.
+    /// Partner slots, each greater than the owner's slot and in its layer or the next.
     pub neighbors: Vec<u32>,
-    /// History of each entry's contact (zero while open).
+    /// History of each entry's contact, seen from the owner (zero while open).
     pub history: Vec<ContactHistory>,
-    /// `sqrt(contact area)` of each entry at the last step, 0 when not touching (the
-    /// recorder's per-sample input).
-    pub sqrt_area: Vec<f64>,
-    /// Wall-contact histories, `walls` per particle, in slot order.
+    /// Whether each entry touched at the last step (its history is non-zero only then).
+    pub touching: Vec<bool>,
+    /// First slot of each layer of the cell grid, and the particle count at the end.
+    pub layer_start: Vec<u32>,
+    /// Wall candidates of slot `i` are `wall_offsets[i]..wall_offsets[i + 1]`.
+    pub wall_offsets: Vec<u32>,
+    /// The wall of each candidate.
+    pub wall_index: Vec<u8>,
     pub wall_history: Vec<ContactHistory>,
-    pub walls: usize,
+    pub wall_touching: Vec<bool>,
     /// Extra distance beyond contact kept in the list.
     pub skin: f64,
     /// Positions at the last build; a rebuild is due when one has moved half the skin.
@@ -33,13 +39,36 @@ pub struct NeighborList {
     /// Scratch of the cell sort.
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
+    order: Vec<u32>,
+}
+
+/// Open contacts carried through a rebuild, grouped by the permanent id of their owner.
+struct Carried {
+    /// Contacts of id `a` are `start[a]..start[a + 1]`.
+    start: Vec<u32>,
+    /// Partner id (walls: particle count + wall index) and history seen from the owner.
+    contacts: Vec<(u32, ContactHistory)>,
+}
+
+impl Carried {
+    fn find(&self, owner: u32, partner: u32) -> Option<ContactHistory> {
+        let range = self.start[owner as usize] as usize..self.start[owner as usize + 1] as usize;
+        self.contacts[range]
+            .iter()
+            .find(|(p, _)| *p == partner)
+            .map(|&(_, h)| h)
+    }
+
+    /// The history of the pair `(a, b)` seen from `a`, wherever it was stored.
+    fn pair(&self, a: u32, b: u32) -> Option<ContactHistory> {
+        self.find(a, b)
+            .or_else(|| self.find(b, a).map(ContactHistory::reversed))
+    }
 }
 
 impl NeighborList {
-    pub fn new(particle_count: usize, walls: usize, skin: f64) -> Self {
+    pub fn new(skin: f64) -> Self {
         Self {
-            wall_history: vec![ContactHistory::default(); particle_count * walls],
-            walls,
             skin,
             ..Default::default()
         }
@@ -55,6 +84,7 @@ impl NeighborList {
             .pos
             .par_iter()
             .zip(self.pos_at_build.par_iter())
+            .with_min_len(4096)
             .any(|(p, q)| {
                 // a NaN displacement also forces a rebuild (and the out-of-drum check then reports it)
                 let d2 = norm2(sub(*p, *q));
@@ -62,9 +92,58 @@ impl NeighborList {
             })
     }
 
-    /// Re-sorts `particles` into cell order and rebuilds the list, carrying histories over.
-    pub fn rebuild(&mut self, particles: &mut ParticleSet, grid: &CellGrid) {
+    /// The open contacts (pairs and walls) by owner id; the old lists are released.
+    fn take_open_contacts(&mut self, ids: &[u32]) -> Carried {
+        let n = ids.len();
+        let mut start = vec![0u32; n + 1];
+        let owners = (0..self.offsets.len().saturating_sub(1)).flat_map(|i| {
+            let pairs = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+            let walls = self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize;
+            pairs
+                .filter(|&e| self.touching[e])
+                .chain(walls.filter(|&e| self.wall_touching[e]))
+                .map(move |_| ids[i])
+        });
+        for owner in owners {
+            start[owner as usize + 1] += 1;
+        }
+        for a in 0..n {
+            start[a + 1] += start[a];
+        }
+        let mut fill = start.clone();
+        let mut contacts = vec![(0u32, ContactHistory::default()); start[n] as usize];
+        for i in 0..self.offsets.len().saturating_sub(1) {
+            let owner = ids[i] as usize;
+            let mut put = |partner: u32, h: ContactHistory| {
+                contacts[fill[owner] as usize] = (partner, h);
+                fill[owner] += 1;
+            };
+            for e in self.offsets[i] as usize..self.offsets[i + 1] as usize {
+                if self.touching[e] {
+                    put(ids[self.neighbors[e] as usize], self.history[e]);
+                }
+            }
+            for e in self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize {
+                if self.wall_touching[e] {
+                    put(n as u32 + self.wall_index[e] as u32, self.wall_history[e]);
+                }
+            }
+        }
+        for list in [&mut self.history, &mut self.wall_history] {
+            *list = Vec::new();
+        }
+        self.neighbors = Vec::new();
+        self.touching = Vec::new();
+        self.wall_index = Vec::new();
+        self.wall_touching = Vec::new();
+        Carried { start, contacts }
+    }
+
+    /// Re-sorts `particles` into cell order and rebuilds the lists, carrying histories over.
+    pub fn rebuild(&mut self, particles: &mut ParticleSet, grid: &CellGrid, walls: &WallSet) {
         let n = particles.len();
+        let carried = self.take_open_contacts(&particles.id);
+
         // 1. stable counting sort by cell: ties keep their previous order (deterministic)
         self.cell_of.clear();
         self.cell_of.extend(
@@ -82,55 +161,31 @@ impl NeighborList {
             self.cell_start[c + 1] += self.cell_start[c];
         }
         let mut fill = self.cell_start.clone();
-        let mut order = vec![0u32; n];
+        self.order.clear();
+        self.order.resize(n, 0);
         for (old, &c) in self.cell_of.iter().enumerate() {
-            order[fill[c as usize] as usize] = old as u32;
+            self.order[fill[c as usize] as usize] = old as u32;
             fill[c as usize] += 1;
         }
+        particles.permute(&self.order);
+        let per_layer = grid.cells_per_layer();
+        self.layer_start.clear();
+        self.layer_start
+            .extend((0..=grid.layers()).map(|l| self.cell_start[l * per_layer]));
 
-        // 2. keep the old open contacts keyed by the partner's permanent id
-        let old_offsets = std::mem::take(&mut self.offsets);
-        let old_history = std::mem::take(&mut self.history);
-        let old_partner_id: Vec<u32> = self
-            .neighbors
-            .iter()
-            .map(|&j| particles.id[j as usize])
-            .collect();
-
-        // 3. move every per-particle array into cell order
-        particles.permute(&order);
-        if self.walls > 0 {
-            let w = self.walls;
-            let old = std::mem::take(&mut self.wall_history);
-            self.wall_history = order
-                .iter()
-                .flat_map(|&o| old[o as usize * w..(o as usize + 1) * w].iter().copied())
-                .collect();
-        }
-        let mut cell_sorted = std::mem::take(&mut self.cell_of);
-        permute_field(&mut cell_sorted, &order);
-        self.cell_of = cell_sorted;
-
-        // 4. full list: slot i scans the 27 cells around its own, in a fixed order
+        // 2. half list: slot i scans the cells around its own, in a fixed order, for j > i
         let skin = self.skin;
         let (pos, radius, ids) = (&particles.pos, &particles.radius, &particles.id);
         let cell_start = &self.cell_start;
-        let blocks: Vec<(Vec<u32>, Vec<u32>, Vec<ContactHistory>)> = (0..n.div_ceil(BLOCK))
+        let carried = &carried;
+        let blocks: Vec<ListBlock> = (0..n.div_ceil(BLOCK))
             .into_par_iter()
             .map(|b| {
-                let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
-                let mut counts = Vec::with_capacity(hi - lo);
-                let mut nbrs = Vec::new();
-                let mut hist = Vec::new();
-                for i in lo..hi {
-                    let before = nbrs.len();
+                let mut block = ListBlock::default();
+                for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                    let before = block.neighbors.len();
                     let ci = grid.coords(pos[i]);
-                    let old_i = order[i] as usize;
-                    let old_range = if old_offsets.is_empty() {
-                        0..0
-                    } else {
-                        old_offsets[old_i] as usize..old_offsets[old_i + 1] as usize
-                    };
+                    let own_cell = grid.index(ci);
                     for dz in -1i64..=1 {
                         for dy in -1i64..=1 {
                             for dx in -1i64..=1 {
@@ -140,42 +195,68 @@ impl NeighborList {
                                 }
                                 let cell =
                                     grid.index([c[0] as usize, c[1] as usize, c[2] as usize]);
-                                for j in cell_start[cell] as usize..cell_start[cell + 1] as usize {
-                                    if j == i {
-                                        continue;
-                                    }
+                                if cell < own_cell {
+                                    continue;
+                                }
+                                let first = (cell_start[cell] as usize).max(i + 1);
+                                for j in first..cell_start[cell + 1] as usize {
                                     let cut = radius[i] + radius[j] + skin;
                                     if norm2(sub(pos[i], pos[j])) < cut * cut {
-                                        nbrs.push(j as u32);
-                                        let h = old_range
-                                            .clone()
-                                            .find(|&e| old_partner_id[e] == ids[j])
-                                            .map_or(ContactHistory::default(), |e| old_history[e]);
-                                        hist.push(h);
+                                        let h = carried.pair(ids[i], ids[j]);
+                                        block.neighbors.push(j as u32);
+                                        block.history.push(h.unwrap_or_default());
+                                        block.touching.push(h.is_some());
                                     }
                                 }
                             }
                         }
                     }
-                    counts.push((nbrs.len() - before) as u32);
+                    block.counts.push((block.neighbors.len() - before) as u32);
+                    let walls_before = block.wall_index.len();
+                    for w in 0..walls.len() {
+                        if walls.gap(w, pos[i], radius[i]) < skin {
+                            let h = carried.find(ids[i], n as u32 + w as u32);
+                            block.wall_index.push(w as u8);
+                            block.wall_history.push(h.unwrap_or_default());
+                            block.wall_touching.push(h.is_some());
+                        }
+                    }
+                    block
+                        .wall_counts
+                        .push((block.wall_index.len() - walls_before) as u32);
                 }
-                (counts, nbrs, hist)
+                block
             })
             .collect();
 
-        self.offsets = Vec::with_capacity(n + 1);
+        self.offsets.clear();
         self.offsets.push(0);
-        self.neighbors.clear();
-        for (counts, nbrs, hist) in blocks {
-            for c in counts {
-                let last = *self.offsets.last().unwrap();
+        self.wall_offsets.clear();
+        self.wall_offsets.push(0);
+        let entries: usize = blocks.iter().map(|b| b.neighbors.len()).sum();
+        let wall_entries: usize = blocks.iter().map(|b| b.wall_index.len()).sum();
+        self.neighbors.reserve_exact(entries);
+        self.history.reserve_exact(entries);
+        self.touching.reserve_exact(entries);
+        self.wall_index.reserve_exact(wall_entries);
+        self.wall_history.reserve_exact(wall_entries);
+        self.wall_touching.reserve_exact(wall_entries);
+        for block in blocks {
+            for c in block.counts {
+                let last = *self.offsets.last().expect("starts with 0");
                 self.offsets.push(last + c);
             }
-            self.neighbors.extend_from_slice(&nbrs);
-            self.history.extend_from_slice(&hist);
+            for c in block.wall_counts {
+                let last = *self.wall_offsets.last().expect("starts with 0");
+                self.wall_offsets.push(last + c);
+            }
+            self.neighbors.extend_from_slice(&block.neighbors);
+            self.history.extend_from_slice(&block.history);
+            self.touching.extend_from_slice(&block.touching);
+            self.wall_index.extend_from_slice(&block.wall_index);
+            self.wall_history.extend_from_slice(&block.wall_history);
+            self.wall_touching.extend_from_slice(&block.wall_touching);
         }
-        self.sqrt_area.clear();
-        self.sqrt_area.resize(self.neighbors.len(), 0.0);
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
         self.rebuilds += 1;
@@ -186,4 +267,28 @@ impl NeighborList {
     pub fn range(&self, i: usize) -> std::ops::Range<usize> {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
+
+    /// Wall-candidate range of slot `i`.
+    #[inline(always)]
+    pub fn wall_range(&self, i: usize) -> std::ops::Range<usize> {
+        self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize
+    }
+
+    /// The list entries in use (pairs, walls), for the memory figures.
+    pub fn entries(&self) -> (usize, usize) {
+        (self.neighbors.len(), self.wall_index.len())
+    }
+}
+
+/// One parallel task's share of a list build.
+#[derive(Default)]
+struct ListBlock {
+    counts: Vec<u32>,
+    neighbors: Vec<u32>,
+    history: Vec<ContactHistory>,
+    touching: Vec<bool>,
+    wall_counts: Vec<u32>,
+    wall_index: Vec<u8>,
+    wall_history: Vec<ContactHistory>,
+    wall_touching: Vec<bool>,
 }

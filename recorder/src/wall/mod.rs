@@ -107,6 +107,16 @@ impl WallSet {
         })
     }
 
+    /// Distance from the surface of a sphere to wall `w` (negative when they overlap): the
+    /// broad-phase test that lists the sphere as a candidate of the wall.
+    #[inline(always)]
+    pub fn gap(&self, w: usize, pos: Vec3, radius: f64) -> f64 {
+        match self.walls[w].0 {
+            Wall::Mantle { radius: rd } => rd - (pos[0] * pos[0] + pos[2] * pos[2]).sqrt() - radius,
+            Wall::Plane { point, normal } => dot(sub(pos, point), normal) - radius,
+        }
+    }
+
     /// Temperature of wall `w` if it conducts (only the mantle can be heated).
     #[inline(always)]
     pub fn temperature(&self, w: usize) -> Option<f64> {

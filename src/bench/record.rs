@@ -1,4 +1,4 @@
-//! `tdex bench`: measured figures for docs/benchmarks.md, each against its peer in the same run.
+//! `tdex bench record`: the recording overhead and bytes per row against a plain period.
 
 use crate::cli::BenchRecordPlan;
 use anyhow::Result;
