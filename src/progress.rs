@@ -54,3 +54,17 @@ pub fn runs_bar(hidden: bool, total: usize, what: &str) -> ProgressBar {
     );
     bar
 }
+
+/// A spinner for a stage of unknown length (an external program), with its elapsed time.
+pub fn spinner(hidden: bool, what: &str) -> ProgressBar {
+    if hidden {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new_spinner();
+    bar.set_style(
+        ProgressStyle::with_template(&format!("{{spinner}} {what} ({{elapsed}})"))
+            .expect("static template"),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
+}

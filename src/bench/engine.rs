@@ -5,7 +5,7 @@ use super::{liggghts, peak_resident_bytes};
 use crate::cli::BenchPlan;
 use anyhow::Result;
 use recorder::counters::Counters;
-use recorder::record::{self, Phase};
+use recorder::record;
 use serde::Serialize;
 use std::time::Instant;
 

@@ -1,9 +1,20 @@
-//! The LIGGGHTS 3.8 peer of `tdex bench CASE`: the case as a LIGGGHTS deck, run for the same
-//! steps on one process.
+//! The LIGGGHTS 3.8 peer of `tdex bench CASE`: the case written as a LIGGGHTS deck (same
+//! materials, Hertz + history + rolling, conduction, the drum as an STL mesh turned by
+//! `fix move/mesh`), run on one process for the same steps after the same settling.
 
 use crate::cli::BenchPlan;
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
+use recorder::case::{Case, ContactArea, EndCaps, RollingModel, TemperatureMode};
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The deck, with `@name@` placeholders (shared with `tests/liggghts/deck_from_case.py`).
+const DECK: &str = include_str!("liggghts_deck.in");
+/// Facets around the drum's circumference.
+const FACETS_AROUND: usize = 96;
+/// Target length (m) of one mantle facet along the axis.
+const FACET_LENGTH: f64 = 0.02;
 
 pub struct PeerRate {
     pub particle_steps_per_s: f64,
@@ -11,6 +22,295 @@ pub struct PeerRate {
     pub dir: PathBuf,
 }
 
-pub fn run(_plan: &BenchPlan, _dir: Option<&Path>) -> Result<PeerRate> {
-    bail!("--vs-liggghts is not built yet")
+/// Writes the deck into `dir` (a new temporary directory if `None`), runs `liggghts` there and
+/// reads the rate of its last run (the heated phase) from the log.
+pub fn run(plan: &BenchPlan, dir: Option<&Path>) -> Result<PeerRate> {
+    let dir = match dir {
+        Some(d) => d.to_path_buf(),
+        None => std::env::temp_dir().join(format!("tdex-bench-liggghts-{}", std::process::id())),
+    };
+    std::fs::create_dir_all(&dir)
+        .with_context(|| format!("cannot create the LIGGGHTS directory {}", dir.display()))?;
+    write_deck(&plan.case, &plan.case_path, plan.steps, &dir)?;
+    let bar = crate::progress::spinner(
+        plan.json,
+        &format!("LIGGGHTS 3.8, 1 process, in {}", dir.display()),
+    );
+    let screen = std::fs::File::create(dir.join("screen.txt"))
+        .with_context(|| format!("cannot write {}", dir.join("screen.txt").display()))?;
+    let status = Command::new("liggghts")
+        .args(["-in", "in.drum", "-log", "log.liggghts", "-echo", "none"])
+        .current_dir(&dir)
+        .stdout(screen.try_clone()?)
+        .stderr(screen)
+        .status();
+    bar.finish_and_clear();
+    let status = match status {
+        Ok(s) => s,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
+            "--vs-liggghts: `liggghts` is not on PATH (install LIGGGHTS 3.8: apt-get install -y liggghts)"
+        ),
+        Err(e) => return Err(e).context("cannot start liggghts"),
+    };
+    if !status.success() {
+        bail!(
+            "liggghts failed ({status}); see {}",
+            dir.join("screen.txt").display()
+        );
+    }
+    let log_path = dir.join("log.liggghts");
+    let log = std::fs::read_to_string(&log_path)
+        .with_context(|| format!("cannot read {}", log_path.display()))?;
+    let (seconds, steps, atoms) = last_loop_time(&log)
+        .with_context(|| format!("{}: no 'Loop time' line", log_path.display()))?;
+    if steps != plan.steps || atoms != plan.case.particles.count as u64 {
+        bail!(
+            "{}: the last run was {steps} steps with {atoms} atoms, expected {} steps with {} atoms",
+            log_path.display(),
+            plan.steps,
+            plan.case.particles.count
+        );
+    }
+    Ok(PeerRate {
+        particle_steps_per_s: (steps * atoms) as f64 / seconds,
+        seconds,
+        dir,
+    })
+}
+
+/// `(seconds, steps, atoms)` of the last "Loop time of S on P procs for N steps with A atoms".
+fn last_loop_time(log: &str) -> Option<(f64, u64, u64)> {
+    let line = log.lines().rev().find(|l| l.starts_with("Loop time of "))?;
+    let words: Vec<&str> = line.split_whitespace().collect();
+    // Loop time of S on P procs for N steps with A atoms
+    Some((
+        words.get(3)?.parse().ok()?,
+        words.get(8)?.parse().ok()?,
+        words.get(11)?.parse().ok()?,
+    ))
+}
+
+/// The first prime above `n` (LIGGGHTS wants prime seeds above 10 000).
+fn next_prime(mut n: u64) -> u64 {
+    let is_prime = |n: u64| n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0);
+    while !is_prime(n) {
+        n += 1;
+    }
+    n
+}
+
+/// Writes `in.drum` and the drum mesh for `case`, heating for `heating_steps` after `t0`.
+pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> Result<()> {
+    let t = &case.temperature;
+    if t.mode != TemperatureMode::Split {
+        bail!("--vs-liggghts: the deck needs temperature.mode = \"split\" (the case has a uniform start)");
+    }
+    if case.conduction.contact_area != ContactArea::Overlap {
+        bail!("--vs-liggghts: LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area (the case sets conduction.contact_area = \"hertz\")");
+    }
+    if case.drum.wall_temperature.is_some() {
+        bail!("--vs-liggghts: the deck has no heated wall (the case sets drum.wall_temperature)");
+    }
+    let (r, l, rp) = (case.drum.radius, case.drum.length, case.particles.radius);
+    let (meshes, mesh_fixes, n_meshes, names, rotating) = match case.drum.end_caps {
+        EndCaps::Rotating => (
+            vec![("drum.stl", true, true)],
+            "fix drum all mesh/surface file drum.stl type 2".to_string(),
+            1,
+            "drum",
+            "drum",
+        ),
+        EndCaps::Fixed => (
+            vec![
+                ("drum_mantle.stl", true, false),
+                ("drum_caps.stl", false, true),
+            ],
+            "fix mantle all mesh/surface file drum_mantle.stl type 2\nfix caps all mesh/surface file drum_caps.stl type 2".to_string(),
+            2,
+            "mantle caps",
+            "mantle",
+        ),
+    };
+    for (file, mantle, caps) in meshes {
+        let path = dir.join(file);
+        std::fs::write(&path, drum_stl(r, l, mantle, caps))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    let axis = t.split_axis.index();
+    let ext = if axis == 1 { l / 2.0 + 0.01 } else { r + 0.01 };
+    let block = |upper: &str| {
+        let mut b = ["INF"; 6];
+        b[2 * axis + 1] = upper;
+        b.join(" ")
+    };
+    let s1 = next_prime(10_001 + case.seed % 1_000_000_000);
+    let s2 = next_prime(s1 + 1);
+    let s3 = next_prime(s2 + 1);
+    let (m, pp, pw) = (
+        &case.material,
+        &case.contact.particle_particle,
+        &case.contact.particle_wall,
+    );
+    let e_real = case.conduction.youngs_modulus_real;
+    let settle = case.steps_in(case.time.settle);
+    let (hot, cold) = (t.hot.unwrap_or(0.0), t.cold.unwrap_or(0.0));
+    let values: Vec<(&str, String)> = vec![
+        (
+            "case",
+            case_path
+                .file_name()
+                .map_or(String::new(), |f| f.to_string_lossy().into()),
+        ),
+        ("name", case.name.clone()),
+        ("seed", case.seed.to_string()),
+        ("bx", (r + 0.01).to_string()),
+        ("by", (l / 2.0 + 0.01).to_string()),
+        ("skin", (0.4 * rp).to_string()),
+        ("E", m.youngs_modulus.to_string()),
+        ("nu", m.poisson_ratio.to_string()),
+        ("k", m.conductivity.to_string()),
+        ("cp", m.heat_capacity.to_string()),
+        ("rho", m.density.to_string()),
+        ("rp", rp.to_string()),
+        ("N", case.particles.count.to_string()),
+        ("dt", case.time.dt.to_string()),
+        ("e_pp", pp.restitution.to_string()),
+        ("e_pw", pw.restitution.to_string()),
+        ("mu_pp", pp.friction.to_string()),
+        ("mu_pw", pw.friction.to_string()),
+        ("mur_pp", pp.rolling_friction.to_string()),
+        ("mur_pw", pw.rolling_friction.to_string()),
+        (
+            "rolling",
+            match case.contact.rolling_model {
+                RollingModel::Epsd2 => "epsd2",
+                RollingModel::Cdt => "cdt",
+                RollingModel::Off => "off",
+            }
+            .into(),
+        ),
+        (
+            "E_real_fix",
+            e_real.map_or(String::new(), |e| {
+                format!("fix m8 all property/global youngsModulusOriginal peratomtype {e} {e}")
+            }),
+        ),
+        (
+            "area_corr",
+            if e_real.is_some() { "yes" } else { "no" }.into(),
+        ),
+        ("mesh_fixes", mesh_fixes),
+        ("n_meshes", n_meshes.to_string()),
+        ("meshes", names.into()),
+        ("rotating", rotating.into()),
+        ("T_init", (0.5 * (hot + cold)).to_string()),
+        ("T_hot", hot.to_string()),
+        ("T_cold", cold.to_string()),
+        ("rins", (r - 1.5 * rp).to_string()),
+        ("yins", (l / 2.0 - 1.5 * rp).to_string()),
+        ("seed1", s1.to_string()),
+        ("seed2", s2.to_string()),
+        ("seed3", s3.to_string()),
+        ("nsettle", settle.to_string()),
+        ("nsettle_rest", settle.saturating_sub(1).to_string()),
+        ("period", case.drum.rotation_period.to_string()),
+        ("nspin", case.steps_in(case.time.spin_up).to_string()),
+        ("nheat", heating_steps.to_string()),
+        ("ax", ["x", "y", "z"][axis].into()),
+        ("ext", ext.to_string()),
+        ("tmp_block", block("${mid}")),
+        ("hot_block", block("${split}")),
+    ];
+    let mut deck = String::with_capacity(DECK.len() + 512);
+    let mut rest = DECK;
+    while let Some(at) = rest.find('@') {
+        deck.push_str(&rest[..at]);
+        let after = &rest[at + 1..];
+        let end = after
+            .find('@')
+            .context("liggghts_deck.in: an unclosed @placeholder@")?;
+        let key = &after[..end];
+        let value = values
+            .iter()
+            .find(|(k, _)| *k == key)
+            .with_context(|| format!("liggghts_deck.in: no value for @{key}@"))?;
+        deck.push_str(&value.1);
+        rest = &after[end + 1..];
+    }
+    deck.push_str(rest);
+    let path = dir.join("in.drum");
+    std::fs::write(&path, deck).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// An ASCII STL of the drum (axis y through the origin): the mantle and/or the end caps.
+fn drum_stl(r: f64, l: f64, mantle: bool, caps: bool) -> String {
+    let ring: Vec<(f64, f64)> = (0..FACETS_AROUND)
+        .map(|k| {
+            let a = 2.0 * std::f64::consts::PI * k as f64 / FACETS_AROUND as f64;
+            (r * a.cos(), r * a.sin())
+        })
+        .collect();
+    let along = ((l / FACET_LENGTH).ceil() as usize).max(1);
+    let ys: Vec<f64> = (0..=along)
+        .map(|j| -l / 2.0 + l * j as f64 / along as f64)
+        .collect();
+    let mut out = String::from("solid drum\n");
+    let mut facet = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let s = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        let s = if s > 0.0 { s } else { 1.0 };
+        let _ = writeln!(
+            out,
+            "facet normal {:.9e} {:.9e} {:.9e}\n outer loop",
+            n[0] / s,
+            n[1] / s,
+            n[2] / s
+        );
+        for p in [a, b, c] {
+            let _ = writeln!(out, " vertex {:.12e} {:.12e} {:.12e}", p[0], p[1], p[2]);
+        }
+        out.push_str(" endloop\nendfacet\n");
+    };
+    for k in 0..FACETS_AROUND {
+        let ((x0, z0), (x1, z1)) = (ring[k], ring[(k + 1) % FACETS_AROUND]);
+        if mantle {
+            for w in ys.windows(2) {
+                let (y0, y1) = (w[0], w[1]);
+                facet([x0, y0, z0], [x1, y0, z1], [x1, y1, z1]);
+                facet([x0, y0, z0], [x1, y1, z1], [x0, y1, z0]);
+            }
+        }
+        if caps {
+            let (lo, hi) = (-l / 2.0, l / 2.0);
+            facet([0.0, lo, 0.0], [x1, lo, z1], [x0, lo, z0]);
+            facet([0.0, hi, 0.0], [x0, hi, z0], [x1, hi, z1]);
+        }
+    }
+    out.push_str("endsolid drum\n");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reads_the_rate_of_the_last_run() {
+        let log = "Loop time of 1.5 on 1 procs for 100 steps with 2000 atoms\n\
+                   ...\nLoop time of 12.25 on 1 procs for 5000 steps with 20000 atoms\n";
+        assert_eq!(last_loop_time(log), Some((12.25, 5000, 20000)));
+        assert_eq!(last_loop_time("no runs"), None);
+    }
+
+    #[test]
+    fn seeds_are_primes_above_ten_thousand() {
+        assert_eq!(next_prime(10_001 + 42), 10_061);
+        assert_eq!(next_prime(10_062), 10_067);
+    }
 }

@@ -116,7 +116,6 @@ pub struct ExtrapolatePlan {
 /// `tdex bench CASE`: engine throughput on the heated phase, optionally against LIGGGHTS.
 pub struct BenchPlan {
     pub case_path: PathBuf,
-    pub case_toml: String,
     pub case: Case,
     pub steps: u64,
     pub threads: usize,
@@ -302,13 +301,12 @@ impl Plan {
                 if steps == 0 {
                     return Err(usage("--steps = 0 is not allowed: give at least 1".into()));
                 }
-                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
+                let loaded = recorder::case::load(&case)?;
                 if let Some(dir) = &liggghts_dir {
                     check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
                 }
                 Ok(Plan::Bench(BenchPlan {
                     case_path: case,
-                    case_toml,
                     case: loaded,
                     steps,
                     threads,
