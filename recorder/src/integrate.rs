@@ -6,10 +6,21 @@ use rayon::prelude::*;
 
 /// Moment of inertia of a solid sphere is `INERTIA · m R²`.
 const INERTIA: f64 = 0.4;
+/// Particles per parallel task: enough work to pay for the dispatch.
+const MIN_TASK: usize = 4096;
 
-/// First half kick and drift: `v += dt/2 (F/m + g)`, `x += dt v`, `ω += dt/2 T/I`.
-pub fn initial_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3) {
+/// First half kick and drift: `v += dt/2 (F/m + g)`, `x += dt v`, `ω += dt/2 T/I`. Returns
+/// whether a particle now lies farther than `limit` from its place in `reference` (or the
+/// reference is missing): the Verlet list's rebuild test, done in the same pass.
+pub fn initial_integrate(
+    p: &mut ParticleSet,
+    dt: f64,
+    gravity: Vec3,
+    reference: &[Vec3],
+    limit: f64,
+) -> bool {
     let half = 0.5 * dt;
+    let n = p.len();
     let ParticleSet {
         pos,
         vel,
@@ -20,24 +31,38 @@ pub fn initial_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3) {
         mass,
         ..
     } = p;
-    (pos, vel, omega)
-        .into_par_iter()
-        .zip((
-            force.par_iter(),
-            torque.par_iter(),
-            radius.par_iter(),
-            mass.par_iter(),
-        ))
-        .with_min_len(4096)
-        .for_each(|((x, v, w), (f, t, r, m))| {
-            *v = add(*v, scale(add(scale(*f, 1.0 / m), gravity), half));
-            *x = add(*x, scale(*v, dt));
-            *w = add(*w, scale(*t, half / (INERTIA * m * r * r)));
-        });
+    let kick = |(x, v, w): (&mut Vec3, &mut Vec3, &mut Vec3),
+                (f, t, r, m): (&Vec3, &Vec3, &f64, &f64)| {
+        *v = add(*v, scale(add(scale(*f, 1.0 / m), gravity), half));
+        *x = add(*x, scale(*v, dt));
+        *w = add(*w, scale(*t, half / (INERTIA * m * r * r)));
+    };
+    let kicked = (pos, vel, omega).into_par_iter().zip((
+        force.par_iter(),
+        torque.par_iter(),
+        radius.par_iter(),
+        mass.par_iter(),
+    ));
+    if reference.len() != n {
+        kicked.with_min_len(MIN_TASK).for_each(|(a, b)| kick(a, b));
+        return true;
+    }
+    let limit2 = limit * limit;
+    kicked
+        .zip(reference.par_iter())
+        .with_min_len(MIN_TASK)
+        .map(|((a, b), x0)| {
+            kick((&mut *a.0, a.1, a.2), b);
+            // a NaN displacement also forces a rebuild (and the out-of-drum check then reports it)
+            let d2 = norm2(sub(*a.0, *x0));
+            d2.is_nan() || d2 > limit2
+        })
+        .reduce(|| false, |a, b| a || b)
 }
 
-/// Second half kick: `v += dt/2 (F/m + g)`, `ω += dt/2 T/I`.
-pub fn final_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3) {
+/// Second half kick `v += dt/2 (F/m + g)`, `ω += dt/2 T/I`, and forward Euler on the heat
+/// flows of this step, `T += dt Q / (m c)`.
+pub fn final_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3, heat_capacity: f64) {
     let half = 0.5 * dt;
     let ParticleSet {
         vel,
@@ -46,24 +71,28 @@ pub fn final_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3) {
         torque,
         radius,
         mass,
+        temp,
+        heat_flow,
         ..
     } = p;
-    (vel, omega)
+    (vel, omega, temp)
         .into_par_iter()
         .zip((
             force.par_iter(),
             torque.par_iter(),
             radius.par_iter(),
             mass.par_iter(),
+            heat_flow.par_iter(),
         ))
-        .with_min_len(4096)
-        .for_each(|((v, w), (f, t, r, m))| {
+        .with_min_len(MIN_TASK)
+        .for_each(|((v, w, temp), (f, t, r, m, q))| {
             *v = add(*v, scale(add(scale(*f, 1.0 / m), gravity), half));
             *w = add(*w, scale(*t, half / (INERTIA * m * r * r)));
+            *temp += dt * q / (m * heat_capacity);
         });
 }
 
-/// Forward Euler on the heat flows of this step: `T += dt Q / (m c)`.
+/// Forward Euler on the heat flows alone (tests of conduction without motion).
 pub fn update_temperatures(p: &mut ParticleSet, dt: f64, heat_capacity: f64) {
     let ParticleSet {
         temp,
@@ -73,6 +102,6 @@ pub fn update_temperatures(p: &mut ParticleSet, dt: f64, heat_capacity: f64) {
     } = p;
     (temp, heat_flow.par_iter(), mass.par_iter())
         .into_par_iter()
-        .with_min_len(4096)
+        .with_min_len(MIN_TASK)
         .for_each(|(t, q, m)| *t += dt * q / (m * heat_capacity));
 }

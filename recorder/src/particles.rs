@@ -1,5 +1,7 @@
 //! The particle set: one array per field (LAMMPS style), permuted together into cell order.
 
+use rayon::prelude::*;
+
 /// Spheres of the simulation. Index `i` is the memory slot (changes at every re-sort);
 /// `id[i]` is the particle's permanent id.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -67,7 +69,11 @@ impl ParticleSet {
 }
 
 /// `field[i] = old[order[i]]`.
-pub fn permute_field<T: Copy>(field: &mut Vec<T>, order: &[u32]) {
-    let permuted: Vec<T> = order.iter().map(|&o| field[o as usize]).collect();
+pub fn permute_field<T: Copy + Send + Sync>(field: &mut Vec<T>, order: &[u32]) {
+    let permuted: Vec<T> = order
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&o| field[o as usize])
+        .collect();
     *field = permuted;
 }

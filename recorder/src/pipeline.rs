@@ -53,11 +53,18 @@ impl Pipeline {
         walls: &WallSet,
         counters: &mut Counters,
     ) -> ContactCount {
-        timed(&mut counters.integrate, || {
-            integrate::initial_integrate(particles, params.dt, params.gravity)
+        // the drift also measures how far the particles have moved since the list was built
+        let moved_far = timed(&mut counters.integrate, || {
+            integrate::initial_integrate(
+                particles,
+                params.dt,
+                params.gravity,
+                &neighbors.pos_at_build,
+                0.5 * neighbors.skin,
+            )
         });
         timed(&mut counters.neighbor, || {
-            if neighbors.needs_rebuild(particles) {
+            if moved_far {
                 neighbors.rebuild(particles, &self.grid, walls);
             }
         });
@@ -68,8 +75,12 @@ impl Pipeline {
             wall_interactions(params, particles, neighbors, walls)
         });
         timed(&mut counters.integrate, || {
-            integrate::final_integrate(particles, params.dt, params.gravity);
-            integrate::update_temperatures(particles, params.dt, params.conduction.heat_capacity);
+            integrate::final_integrate(
+                particles,
+                params.dt,
+                params.gravity,
+                params.conduction.heat_capacity,
+            );
         });
         counters.steps += 1;
         counters.particle_steps += particles.len() as u64;
@@ -144,8 +155,10 @@ pub fn pair_interactions(
         history,
         touching,
         layer_start,
+        uniform_pair,
         ..
     } = neighbors;
+    let uniform_pair = *uniform_pair;
     let layers = layer_start.len().saturating_sub(1);
     let state = |i: usize| SphereState {
         pos: pos[i],
@@ -200,7 +213,11 @@ pub fn pair_interactions(
                         }
                         continue;
                     };
-                    let c = sphere_sphere::kinematics(&si, &state(j), delta, r2);
+                    let sj = state(j);
+                    let eff = uniform_pair.unwrap_or_else(|| {
+                        sphere_sphere::effective(si.radius, sj.radius, si.mass, sj.mass)
+                    });
+                    let c = sphere_sphere::kinematics(&si, &sj, delta, r2, eff);
                     let resp = hertz_mindlin::respond(law, &c.kinematics, &mut h[local], dt);
                     touch[local] = true;
                     let jl = j - first_slot;

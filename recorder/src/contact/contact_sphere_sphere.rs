@@ -32,10 +32,23 @@ pub fn overlapping(delta: Vec3, ri: f64, rj: f64) -> Option<f64> {
     (r2 < radsum * radsum).then_some(r2)
 }
 
-/// Kinematics of `i` against `j`, given `delta = x_i − x_j` and its squared length `r2`
-/// from [`overlapping`].
+/// Effective radius and mass `(R*, m*)` of a pair.
 #[inline(always)]
-pub fn kinematics(i: &SphereState, j: &SphereState, delta: Vec3, r2: f64) -> PairContact {
+pub fn effective(ri: f64, rj: f64, mi: f64, mj: f64) -> (f64, f64) {
+    (ri * rj / (ri + rj), mi * mj / (mi + mj))
+}
+
+/// Kinematics of `i` against `j`, given `delta = x_i − x_j` and its squared length `r2`
+/// from [`overlapping`], and the pair's `(R*, m*)` from [`effective`] (passed in so that
+/// equal spheres compute it once).
+#[inline(always)]
+pub fn kinematics(
+    i: &SphereState,
+    j: &SphereState,
+    delta: Vec3,
+    r2: f64,
+    (r_eff, m_eff): (f64, f64),
+) -> PairContact {
     let radsum = i.radius + j.radius;
     let r = r2.sqrt();
     let overlap = radsum - r;
@@ -49,8 +62,8 @@ pub fn kinematics(i: &SphereState, j: &SphereState, delta: Vec3, r2: f64) -> Pai
             rel_vel: sub(i.vel, j.vel),
             lever_omega: add(scale(i.omega, lever_i), scale(j.omega, lever_j)),
             roll_omega: sub(i.omega, j.omega),
-            r_eff: i.radius * j.radius / radsum,
-            m_eff: i.mass * j.mass / (i.mass + j.mass),
+            r_eff,
+            m_eff,
         },
         distance: r,
         lever_i,

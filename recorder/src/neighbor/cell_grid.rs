@@ -21,9 +21,11 @@ impl CellGrid {
         for k in 0..3 {
             dims[k] = (((hi[k] - lo[k]) / min_cell).floor() as usize).max(1);
         }
-        // the longest axis is the layer axis: the most layers, the most parallel tasks
+        // the longest axis is the layer axis: the most layers, the most parallel tasks; of
+        // equal ones the first, so that a drum (axis y, gravity −z) is not cut into
+        // horizontal layers its bed only half fills
         let mut axes = [0, 1, 2];
-        axes.sort_by_key(|&k| (dims[k], k));
+        axes.sort_by_key(|&k| (dims[k], std::cmp::Reverse(k)));
         // cells stay ≥ min_cell: the box is widened to a whole number of them
         Self {
             origin: lo,
@@ -70,6 +72,13 @@ impl CellGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn of_equal_axes_the_first_is_the_layer_axis() {
+        let grid = CellGrid::new([0.0; 3], [4.0, 3.0, 4.0], 1.0);
+        assert_eq!(grid.layers(), 4);
+        assert!(grid.index([1, 0, 0]) >= grid.cells_per_layer());
+    }
 
     #[test]
     fn the_longest_axis_is_the_layer_axis() {

@@ -4,6 +4,7 @@
 //! in the force loop) and every open contact's history follows its pair into the new list.
 
 use super::CellGrid;
+use crate::contact::contact_sphere_sphere::{effective, overlapping};
 use crate::contact::ContactHistory;
 use crate::math::*;
 use crate::particles::ParticleSet;
@@ -33,9 +34,13 @@ pub struct NeighborList {
     pub wall_touching: Vec<bool>,
     /// Extra distance beyond contact kept in the list.
     pub skin: f64,
-    /// Positions at the last build; a rebuild is due when one has moved half the skin.
+    /// Positions at the last build; a rebuild is due when one has moved half the skin (the
+    /// drift of `integrate::initial_integrate` tests it).
     pub pos_at_build: Vec<Vec3>,
     pub rebuilds: u64,
+    /// `(R*, m*)` of every pair when all spheres have one radius and one mass (the pair
+    /// stage then skips two divisions per pair).
+    pub uniform_pair: Option<(f64, f64)>,
     /// Scratch of the cell sort.
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
@@ -72,24 +77,6 @@ impl NeighborList {
             skin,
             ..Default::default()
         }
-    }
-
-    /// Whether any particle has moved more than half the skin since the last build.
-    pub fn needs_rebuild(&self, particles: &ParticleSet) -> bool {
-        if self.pos_at_build.len() != particles.len() {
-            return true;
-        }
-        let limit = 0.25 * self.skin * self.skin;
-        particles
-            .pos
-            .par_iter()
-            .zip(self.pos_at_build.par_iter())
-            .with_min_len(4096)
-            .any(|(p, q)| {
-                // a NaN displacement also forces a rebuild (and the out-of-drum check then reports it)
-                let d2 = norm2(sub(*p, *q));
-                d2.is_nan() || d2 > limit
-            })
     }
 
     /// The open contacts (pairs and walls) by owner id; the old lists are released.
@@ -145,13 +132,11 @@ impl NeighborList {
         let carried = self.take_open_contacts(&particles.id);
 
         // 1. stable counting sort by cell: ties keep their previous order (deterministic)
-        self.cell_of.clear();
-        self.cell_of.extend(
-            particles
-                .pos
-                .iter()
-                .map(|&p| grid.index(grid.coords(p)) as u32),
-        );
+        particles
+            .pos
+            .par_iter()
+            .map(|&p| grid.index(grid.coords(p)) as u32)
+            .collect_into_vec(&mut self.cell_of);
         self.cell_start.clear();
         self.cell_start.resize(grid.cell_count() + 1, 0);
         for &c in &self.cell_of {
@@ -201,8 +186,12 @@ impl NeighborList {
                                 let first = (cell_start[cell] as usize).max(i + 1);
                                 for j in first..cell_start[cell + 1] as usize {
                                     let cut = radius[i] + radius[j] + skin;
-                                    if norm2(sub(pos[i], pos[j])) < cut * cut {
-                                        let h = carried.pair(ids[i], ids[j]);
+                                    let delta = sub(pos[i], pos[j]);
+                                    if norm2(delta) < cut * cut {
+                                        // a history matters only to a pair touching now (the
+                                        // pair stage's own test): it resets the others
+                                        let h = overlapping(delta, radius[i], radius[j])
+                                            .and_then(|_| carried.pair(ids[i], ids[j]));
                                         block.neighbors.push(j as u32);
                                         block.history.push(h.unwrap_or_default());
                                         block.touching.push(h.is_some());
@@ -259,6 +248,16 @@ impl NeighborList {
         }
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
+        let (r0, m0) = (particles.radius.first(), particles.mass.first());
+        self.uniform_pair = match (r0, m0) {
+            (Some(&r), Some(&m))
+                if particles.radius.iter().all(|&x| x == r)
+                    && particles.mass.iter().all(|&x| x == m) =>
+            {
+                Some(effective(r, r, m, m))
+            }
+            _ => None,
+        };
         self.rebuilds += 1;
     }
 
