@@ -1,5 +1,5 @@
-//! tdex recorder: case files, the thermal DEM engine of a rotating drum, and (to come) the
-//! collision recorder and its file format.
+//! tdex recorder: case files, the thermal DEM engine of a rotating drum, the collision
+//! recorder and its file format.
 //!
 //! Stages follow a DEM step: [`neighbor`] (cell grid, Verlet list), [`contact`] (one file per
 //! force law or pair kind), [`wall`], [`heat`] (conduction), [`integrate`], tied together by
@@ -18,6 +18,7 @@ pub mod particles;
 pub mod pipeline;
 pub mod record;
 pub mod simulation;
+pub mod slices;
 pub mod wall;
 
 pub use case::{Case, CaseError};

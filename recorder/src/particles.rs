@@ -44,18 +44,17 @@ impl ParticleSet {
         self.heat_flow.push(0.0);
     }
 
-    /// Reorders every field so that new slot `i` holds what old slot `order[i]` held.
-    pub fn permute(&mut self, order: &[u32]) {
-        permute_field(&mut self.id, order);
-        permute_field(&mut self.pos, order);
-        permute_field(&mut self.vel, order);
-        permute_field(&mut self.omega, order);
-        permute_field(&mut self.force, order);
-        permute_field(&mut self.torque, order);
-        permute_field(&mut self.radius, order);
-        permute_field(&mut self.mass, order);
-        permute_field(&mut self.temp, order);
-        permute_field(&mut self.heat_flow, order);
+    /// Reorders the state fields so that new slot `i` holds what old slot `order[i]` held.
+    /// The per-step outputs (`force`, `torque`, `heat_flow`) are left in the old order: the
+    /// pair stage zeroes and refills them after every re-sort.
+    pub fn permute_state(&mut self, order: &[u32], scratch: &mut PermuteScratch) {
+        permute_field(&mut self.id, order, &mut scratch.ids);
+        for field in [&mut self.pos, &mut self.vel, &mut self.omega] {
+            permute_field(field, order, &mut scratch.vectors);
+        }
+        for field in [&mut self.radius, &mut self.mass, &mut self.temp] {
+            permute_field(field, order, &mut scratch.scalars);
+        }
     }
 
     /// Slot of every id: `slot_of()[id] = i`.
@@ -68,12 +67,20 @@ impl ParticleSet {
     }
 }
 
-/// `field[i] = old[order[i]]`.
-pub fn permute_field<T: Copy + Send + Sync>(field: &mut Vec<T>, order: &[u32]) {
-    let permuted: Vec<T> = order
+/// Buffers reused by every re-sort (one per field type), so that a rebuild allocates nothing.
+#[derive(Debug, Clone, Default)]
+pub struct PermuteScratch {
+    ids: Vec<u32>,
+    vectors: Vec<[f64; 3]>,
+    scalars: Vec<f64>,
+}
+
+/// `field[i] = old[order[i]]`, through `scratch` (which then holds the old order).
+pub fn permute_field<T: Copy + Send + Sync>(field: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
+    order
         .par_iter()
         .with_min_len(4096)
         .map(|&o| field[o as usize])
-        .collect();
-    *field = permuted;
+        .collect_into_vec(scratch);
+    std::mem::swap(field, scratch);
 }

@@ -9,6 +9,7 @@ use crate::integrate;
 use crate::math::*;
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
+use crate::slices::split_by;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
@@ -86,21 +87,6 @@ impl Pipeline {
         counters.particle_steps += particles.len() as u64;
         ContactCount { pair_entries, wall }
     }
-}
-
-/// Splits `items` into consecutive mutable pieces, piece `b` covering `bounds[b]..bounds[b+1]`
-/// (bounds increasing and not overlapping; gaps are skipped).
-fn split_by<T>(mut items: &mut [T], bounds: impl Iterator<Item = (usize, usize)>) -> Vec<&mut [T]> {
-    let mut pieces = Vec::new();
-    let mut at = 0;
-    for (lo, hi) in bounds {
-        let (_, rest) = std::mem::take(&mut items).split_at_mut(lo - at);
-        let (piece, rest) = rest.split_at_mut(hi - lo);
-        pieces.push(piece);
-        items = rest;
-        at = hi;
-    }
-    pieces
 }
 
 /// Runs `work` on every task, in parallel when there is more than one.

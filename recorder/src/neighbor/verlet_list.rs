@@ -2,12 +2,15 @@
 //! order) and the wall candidates, with every contact's history stored next to its entry.
 //! On rebuild the particles are re-sorted in cell order (memory order is worth several times
 //! in the force loop) and every open contact's history follows its pair into the new list.
+//! The lists are counted, then filled in place: a rebuild allocates nothing once the arrays
+//! have grown to size, and never holds two lists at once.
 
 use super::CellGrid;
 use crate::contact::contact_sphere_sphere::{effective, overlapping};
 use crate::contact::ContactHistory;
 use crate::math::*;
-use crate::particles::ParticleSet;
+use crate::particles::{ParticleSet, PermuteScratch};
+use crate::slices::split_by;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
@@ -41,13 +44,16 @@ pub struct NeighborList {
     /// `(R*, m*)` of every pair when all spheres have one radius and one mass (the pair
     /// stage then skips two divisions per pair).
     pub uniform_pair: Option<(f64, f64)>,
-    /// Scratch of the cell sort.
+    /// Scratch of the cell sort and the re-sort.
     cell_of: Vec<u32>,
     cell_start: Vec<u32>,
     order: Vec<u32>,
+    permute_scratch: PermuteScratch,
+    carried: Carried,
 }
 
 /// Open contacts carried through a rebuild, grouped by the permanent id of their owner.
+#[derive(Debug, Clone, Default)]
 struct Carried {
     /// Contacts of id `a` are `start[a]..start[a + 1]`.
     start: Vec<u32>,
@@ -79,57 +85,46 @@ impl NeighborList {
         }
     }
 
-    /// The open contacts (pairs and walls) by owner id; the old lists are released.
-    fn take_open_contacts(&mut self, ids: &[u32]) -> Carried {
+    /// Collects the open contacts (pairs and walls) by owner id into `self.carried`.
+    fn carry_open_contacts(&mut self, ids: &[u32]) {
         let n = ids.len();
-        let mut start = vec![0u32; n + 1];
-        let owners = (0..self.offsets.len().saturating_sub(1)).flat_map(|i| {
+        let slots = self.offsets.len().saturating_sub(1);
+        let Carried { start, contacts } = &mut self.carried;
+        start.clear();
+        start.resize(n + 1, 0);
+        for i in 0..slots {
             let pairs = self.offsets[i] as usize..self.offsets[i + 1] as usize;
             let walls = self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize;
-            pairs
-                .filter(|&e| self.touching[e])
-                .chain(walls.filter(|&e| self.wall_touching[e]))
-                .map(move |_| ids[i])
-        });
-        for owner in owners {
-            start[owner as usize + 1] += 1;
+            let pairs = self.touching[pairs].iter().filter(|&&t| t).count();
+            let walls = self.wall_touching[walls].iter().filter(|&&t| t).count();
+            start[ids[i] as usize + 1] += (pairs + walls) as u32;
         }
         for a in 0..n {
             start[a + 1] += start[a];
         }
-        let mut fill = start.clone();
-        let mut contacts = vec![(0u32, ContactHistory::default()); start[n] as usize];
-        for i in 0..self.offsets.len().saturating_sub(1) {
-            let owner = ids[i] as usize;
-            let mut put = |partner: u32, h: ContactHistory| {
-                contacts[fill[owner] as usize] = (partner, h);
-                fill[owner] += 1;
-            };
+        contacts.clear();
+        contacts.resize(start[n] as usize, (0, ContactHistory::default()));
+        for i in 0..slots {
+            let mut at = start[ids[i] as usize] as usize;
             for e in self.offsets[i] as usize..self.offsets[i + 1] as usize {
                 if self.touching[e] {
-                    put(ids[self.neighbors[e] as usize], self.history[e]);
+                    contacts[at] = (ids[self.neighbors[e] as usize], self.history[e]);
+                    at += 1;
                 }
             }
             for e in self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize {
                 if self.wall_touching[e] {
-                    put(n as u32 + self.wall_index[e] as u32, self.wall_history[e]);
+                    contacts[at] = (n as u32 + self.wall_index[e] as u32, self.wall_history[e]);
+                    at += 1;
                 }
             }
         }
-        for list in [&mut self.history, &mut self.wall_history] {
-            *list = Vec::new();
-        }
-        self.neighbors = Vec::new();
-        self.touching = Vec::new();
-        self.wall_index = Vec::new();
-        self.wall_touching = Vec::new();
-        Carried { start, contacts }
     }
 
     /// Re-sorts `particles` into cell order and rebuilds the lists, carrying histories over.
     pub fn rebuild(&mut self, particles: &mut ParticleSet, grid: &CellGrid, walls: &WallSet) {
         let n = particles.len();
-        let carried = self.take_open_contacts(&particles.id);
+        self.carry_open_contacts(&particles.id);
 
         // 1. stable counting sort by cell: ties keep their previous order (deterministic)
         particles
@@ -145,107 +140,97 @@ impl NeighborList {
         for c in 0..grid.cell_count() {
             self.cell_start[c + 1] += self.cell_start[c];
         }
-        let mut fill = self.cell_start.clone();
         self.order.clear();
         self.order.resize(n, 0);
+        // the cell starts advance as slots are handed out, then step back by one cell
         for (old, &c) in self.cell_of.iter().enumerate() {
-            self.order[fill[c as usize] as usize] = old as u32;
-            fill[c as usize] += 1;
+            self.order[self.cell_start[c as usize] as usize] = old as u32;
+            self.cell_start[c as usize] += 1;
         }
-        particles.permute(&self.order);
+        self.cell_start.rotate_right(1);
+        self.cell_start[0] = 0;
+        particles.permute_state(&self.order, &mut self.permute_scratch);
         let per_layer = grid.cells_per_layer();
         self.layer_start.clear();
         self.layer_start
             .extend((0..=grid.layers()).map(|l| self.cell_start[l * per_layer]));
 
-        // 2. half list: slot i scans the cells around its own, in a fixed order, for j > i
-        let skin = self.skin;
-        let (pos, radius, ids) = (&particles.pos, &particles.radius, &particles.id);
-        let cell_start = &self.cell_start;
-        let carried = &carried;
-        let blocks: Vec<ListBlock> = (0..n.div_ceil(BLOCK))
-            .into_par_iter()
-            .map(|b| {
-                let mut block = ListBlock::default();
-                for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                    let before = block.neighbors.len();
-                    let ci = grid.coords(pos[i]);
-                    let own_cell = grid.index(ci);
-                    for dz in -1i64..=1 {
-                        for dy in -1i64..=1 {
-                            for dx in -1i64..=1 {
-                                let c = [ci[0] as i64 + dx, ci[1] as i64 + dy, ci[2] as i64 + dz];
-                                if (0..3).any(|k| c[k] < 0 || c[k] >= grid.dims[k] as i64) {
-                                    continue;
-                                }
-                                let cell =
-                                    grid.index([c[0] as usize, c[1] as usize, c[2] as usize]);
-                                if cell < own_cell {
-                                    continue;
-                                }
-                                let first = (cell_start[cell] as usize).max(i + 1);
-                                for j in first..cell_start[cell + 1] as usize {
-                                    let cut = radius[i] + radius[j] + skin;
-                                    let delta = sub(pos[i], pos[j]);
-                                    if norm2(delta) < cut * cut {
-                                        // a history matters only to a pair touching now (the
-                                        // pair stage's own test): it resets the others
-                                        let h = overlapping(delta, radius[i], radius[j])
-                                            .and_then(|_| carried.pair(ids[i], ids[j]));
-                                        block.neighbors.push(j as u32);
-                                        block.history.push(h.unwrap_or_default());
-                                        block.touching.push(h.is_some());
-                                    }
-                                }
-                            }
-                        }
-                    }
-                    block.counts.push((block.neighbors.len() - before) as u32);
-                    let walls_before = block.wall_index.len();
-                    for w in 0..walls.len() {
-                        if walls.gap(w, pos[i], radius[i]) < skin {
-                            let h = carried.find(ids[i], n as u32 + w as u32);
-                            block.wall_index.push(w as u8);
-                            block.wall_history.push(h.unwrap_or_default());
-                            block.wall_touching.push(h.is_some());
-                        }
-                    }
-                    block
-                        .wall_counts
-                        .push((block.wall_index.len() - walls_before) as u32);
-                }
-                block
-            })
-            .collect();
-
+        // 2. count each slot's partners and wall candidates, then fill the lists in place
+        let search = Search {
+            grid,
+            cell_start: &self.cell_start,
+            pos: &particles.pos,
+            radius: &particles.radius,
+            skin: self.skin,
+            walls,
+        };
         self.offsets.clear();
-        self.offsets.push(0);
+        self.offsets.resize(n + 1, 0);
         self.wall_offsets.clear();
-        self.wall_offsets.push(0);
-        let entries: usize = blocks.iter().map(|b| b.neighbors.len()).sum();
-        let wall_entries: usize = blocks.iter().map(|b| b.wall_index.len()).sum();
-        self.neighbors.reserve_exact(entries);
-        self.history.reserve_exact(entries);
-        self.touching.reserve_exact(entries);
-        self.wall_index.reserve_exact(wall_entries);
-        self.wall_history.reserve_exact(wall_entries);
-        self.wall_touching.reserve_exact(wall_entries);
-        for block in blocks {
-            for c in block.counts {
-                let last = *self.offsets.last().expect("starts with 0");
-                self.offsets.push(last + c);
-            }
-            for c in block.wall_counts {
-                let last = *self.wall_offsets.last().expect("starts with 0");
-                self.wall_offsets.push(last + c);
-            }
-            self.neighbors.extend_from_slice(&block.neighbors);
-            self.history.extend_from_slice(&block.history);
-            self.touching.extend_from_slice(&block.touching);
-            self.wall_index.extend_from_slice(&block.wall_index);
-            self.wall_history.extend_from_slice(&block.wall_history);
-            self.wall_touching.extend_from_slice(&block.wall_touching);
+        self.wall_offsets.resize(n + 1, 0);
+        self.offsets[1..]
+            .par_iter_mut()
+            .zip(self.wall_offsets[1..].par_iter_mut())
+            .enumerate()
+            .with_min_len(BLOCK)
+            .for_each(|(i, (pairs, walls))| {
+                search.partners(i, |_, _| *pairs += 1);
+                search.walls(i, |_| *walls += 1);
+            });
+        for i in 0..n {
+            self.offsets[i + 1] += self.offsets[i];
+            self.wall_offsets[i + 1] += self.wall_offsets[i];
         }
+        let (entries, wall_entries) = (self.offsets[n] as usize, self.wall_offsets[n] as usize);
+        self.neighbors.resize(entries, 0);
+        self.history.resize(entries, ContactHistory::default());
+        self.touching.resize(entries, false);
+        self.wall_index.resize(wall_entries, 0);
+        self.wall_history
+            .resize(wall_entries, ContactHistory::default());
+        self.wall_touching.resize(wall_entries, false);
+
+        let blocks = || (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
+        let (offsets, wall_offsets) = (&self.offsets, &self.wall_offsets);
+        let entry_bounds =
+            || blocks().map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize));
+        let wall_bounds =
+            || blocks().map(|(lo, hi)| (wall_offsets[lo] as usize, wall_offsets[hi] as usize));
+        let (ids, carried) = (&particles.id, &self.carried);
+        let tasks: Vec<_> = blocks()
+            .zip(split_by(&mut self.neighbors, entry_bounds()))
+            .zip(split_by(&mut self.history, entry_bounds()))
+            .zip(split_by(&mut self.touching, entry_bounds()))
+            .zip(split_by(&mut self.wall_index, wall_bounds()))
+            .zip(split_by(&mut self.wall_history, wall_bounds()))
+            .zip(split_by(&mut self.wall_touching, wall_bounds()))
+            .collect();
+        tasks.into_par_iter().for_each(
+            |((((((range, partner), history), touch), wall), wall_history), wall_touch)| {
+                let (mut e, mut w) = (0, 0);
+                for i in range.0..range.1 {
+                    search.partners(i, |j, now_touching| {
+                        // a history matters only to a pair touching now (the pair stage's
+                        // own test): it resets the others
+                        let h = now_touching
+                            .then(|| carried.pair(ids[i], ids[j]))
+                            .flatten();
+                        partner[e] = j as u32;
+                        history[e] = h.unwrap_or_default();
+                        touch[e] = h.is_some();
+                        e += 1;
+                    });
+                    search.walls(i, |k| {
+                        let h = carried.find(ids[i], n as u32 + k as u32);
+                        wall[w] = k as u8;
+                        wall_history[w] = h.unwrap_or_default();
+                        wall_touch[w] = h.is_some();
+                        w += 1;
+                    });
+                }
+            },
+        );
+
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
         let (r0, m0) = (particles.radius.first(), particles.mass.first());
@@ -279,15 +264,55 @@ impl NeighborList {
     }
 }
 
-/// One parallel task's share of a list build.
-#[derive(Default)]
-struct ListBlock {
-    counts: Vec<u32>,
-    neighbors: Vec<u32>,
-    history: Vec<ContactHistory>,
-    touching: Vec<bool>,
-    wall_counts: Vec<u32>,
-    wall_index: Vec<u8>,
-    wall_history: Vec<ContactHistory>,
-    wall_touching: Vec<bool>,
+/// The broad-phase search over particles already in cell order.
+struct Search<'a> {
+    grid: &'a CellGrid,
+    cell_start: &'a [u32],
+    pos: &'a [Vec3],
+    radius: &'a [f64],
+    skin: f64,
+    walls: &'a WallSet,
+}
+
+impl Search<'_> {
+    /// Calls `found(j, touching_now)` for every `j > i` within the skin, scanning the cells
+    /// around `i`'s own in a fixed order.
+    #[inline(always)]
+    fn partners(&self, i: usize, mut found: impl FnMut(usize, bool)) {
+        let (grid, pos, radius) = (self.grid, self.pos, self.radius);
+        let ci = grid.coords(pos[i]);
+        let own_cell = grid.index(ci);
+        for dz in -1i64..=1 {
+            for dy in -1i64..=1 {
+                for dx in -1i64..=1 {
+                    let c = [ci[0] as i64 + dx, ci[1] as i64 + dy, ci[2] as i64 + dz];
+                    if (0..3).any(|k| c[k] < 0 || c[k] >= grid.dims[k] as i64) {
+                        continue;
+                    }
+                    let cell = grid.index([c[0] as usize, c[1] as usize, c[2] as usize]);
+                    if cell < own_cell {
+                        continue;
+                    }
+                    let first = (self.cell_start[cell] as usize).max(i + 1);
+                    for j in first..self.cell_start[cell + 1] as usize {
+                        let cut = radius[i] + radius[j] + self.skin;
+                        let delta = sub(pos[i], pos[j]);
+                        if norm2(delta) < cut * cut {
+                            found(j, overlapping(delta, radius[i], radius[j]).is_some());
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Calls `found(w)` for every wall within the skin of sphere `i`.
+    #[inline(always)]
+    fn walls(&self, i: usize, mut found: impl FnMut(usize)) {
+        for w in 0..self.walls.len() {
+            if self.walls.gap(w, self.pos[i], self.radius[i]) < self.skin {
+                found(w);
+            }
+        }
+    }
 }
