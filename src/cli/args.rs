@@ -147,6 +147,12 @@ pub enum Command {
     /// Benchmarks (figures for docs/benchmarks.md).
     #[command(subcommand)]
     Bench(BenchCommand),
+    /// Build a recording from another DEM engine's output (docs/liggghts.md).
+    #[command(subcommand)]
+    Import(ImportCommand),
+    /// Write a recording or an extrapolation for other tools.
+    #[command(subcommand)]
+    Export(ExportCommand),
     /// Parameter studies (Haydar §3.2–3.3): sampling (n, Δt_c^max), pairing period τ, and
     /// flow regimes (drum speed), each recorded, extrapolated and compared with the DEM.
     #[command(subcommand)]
@@ -187,6 +193,64 @@ pub enum BenchCommand {
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ImportCommand {
+    /// A recording from LIGGGHTS text dumps: the atoms (`dump custom ... id type x y z vx vy
+    /// vz radius f_Temp`) at t0, t1 = t0 + τ and every later t_k, and the contacts
+    /// (`compute pair/gran/local id contactArea` through `dump local`) every n steps of the
+    /// period; the same table and snapshots as `tdex record` (docs/liggghts.md).
+    Liggghts {
+        /// The atom dump files: a path or a pattern (`*`, `%`, `?` in the file name; quote it),
+        /// plain or gzip, several timesteps and MPI processes merged by timestep.
+        #[arg(long)]
+        atoms: String,
+        /// The contact dump files (`dump local`), as --atoms.
+        #[arg(long)]
+        contacts: String,
+        /// The case file describing the run (time step, materials, conduction, drum).
+        #[arg(long)]
+        case: PathBuf,
+        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// Period τ in seconds (default: one drum revolution).
+        #[arg(long, conflicts_with = "tau_rev")]
+        tau: Option<f64>,
+        /// Period τ as a fraction of a drum revolution.
+        #[arg(long = "tau-rev")]
+        tau_rev: Option<f64>,
+        /// Sampling factor n: a multiple of the contact dumps' spacing (steps).
+        #[arg(long = "n", default_value_t = 10)]
+        n: u32,
+        /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
+        #[arg(long = "dtc-max", default_value_t = 100)]
+        dtc_max: u32,
+        /// Store sqrt(a) as exact f64 instead of 16-bit codes.
+        #[arg(long = "exact-area")]
+        exact_area: bool,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ExportCommand {
+    /// ParaView files: one VTK PolyData file (.vtp) per snapshot with temperature, radius, id
+    /// and velocity, and a .pvd time series that opens them all.
+    Vtk {
+        /// A recording or an extrapolation (MCAP).
+        file: PathBuf,
+        /// The directory for the files (created if missing; files of the same name replaced).
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// For an extrapolation: its recording, to add the DEM − extrapolated temperature
+        /// differences at every t_k that has a DEM reference.
+        #[arg(long)]
+        reference: Option<PathBuf>,
     },
 }
 

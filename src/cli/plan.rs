@@ -1,6 +1,8 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
-use super::args::{BenchCommand, Cli, Command, StudyCommand, StudyCommon};
+use super::args::{
+    BenchCommand, Cli, Command, ExportCommand, ImportCommand, StudyCommand, StudyCommon,
+};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::format::AreaEncoding;
@@ -32,6 +34,27 @@ pub enum Plan {
     Report(ReportPlan),
     Demo(DemoPlan),
     Study(StudyPlan),
+    ImportLiggghts(ImportPlan),
+    ExportVtk(ExportVtkPlan),
+}
+
+/// `tdex import liggghts`: the dumps, the case describing the run and the recording settings
+/// (`reference_periods` is found in the dumps).
+pub struct ImportPlan {
+    pub dumps: recorder::import::liggghts::Dumps,
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub output: PathBuf,
+    pub options: RecordOptions,
+    pub json: bool,
+}
+
+/// `tdex export vtk`.
+pub struct ExportVtkPlan {
+    pub file: PathBuf,
+    pub output: PathBuf,
+    pub reference: Option<PathBuf>,
 }
 
 /// `tdex study ...`: the case, the study directory and what to run.
@@ -276,6 +299,43 @@ impl Plan {
                 Ok(Plan::Demo(DemoPlan { output, threads }))
             }
             Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
+            Command::Import(ImportCommand::Liggghts {
+                atoms,
+                contacts,
+                case,
+                output,
+                tau,
+                tau_rev,
+                n,
+                dtc_max,
+                exact_area,
+                json,
+            }) => {
+                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
+                let options = record_options(&loaded, tau, tau_rev, n, dtc_max, 0, exact_area)?;
+                check_output(&output)?;
+                Ok(Plan::ImportLiggghts(ImportPlan {
+                    dumps: recorder::import::liggghts::Dumps { atoms, contacts },
+                    case_path: case,
+                    case_toml,
+                    case: loaded,
+                    output,
+                    options,
+                    json,
+                }))
+            }
+            Command::Export(ExportCommand::Vtk {
+                file,
+                output,
+                reference,
+            }) => {
+                check_output_dir(&output)?;
+                Ok(Plan::ExportVtk(ExportVtkPlan {
+                    file,
+                    output,
+                    reference,
+                }))
+            }
             Command::Bench(BenchCommand::Record {
                 case,
                 tau_rev,
@@ -409,11 +469,11 @@ fn check_cells(cells: usize) -> Result<()> {
     Ok(())
 }
 
-/// A report directory: an existing directory, or a new one whose parent exists.
+/// An output directory: an existing directory, or a new one whose parent exists.
 fn check_output_dir(dir: &std::path::Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(usage(format!(
-            "-o {}: is a file; give a directory for the report",
+            "-o {}: is a file; give a directory",
             dir.display()
         )));
     }
