@@ -138,6 +138,8 @@ pub fn import(
                 expected += every;
             }
             _ => {
+                // a damaged or misordered frame further on is the more precise error
+                while set.read_next(true)?.is_some() {}
                 let found = match (next, &last) {
                     (Some(s), _) => format!("the next contact dump is at timestep {s}"),
                     (None, Some((s, path))) => {
