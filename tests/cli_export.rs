@@ -6,7 +6,6 @@ use crate::cli_compare::record_and_extrapolate;
 use crate::util::*;
 use recorder::format::{ExtrapolationReader, RecordingReader, Snapshot};
 use serde_json::json;
-use std::collections::BTreeMap;
 use std::path::Path;
 
 fn export(file: &Path, out: &Path, reference: Option<&Path>) -> std::process::Output {
@@ -27,19 +26,6 @@ fn export(file: &Path, out: &Path, reference: Option<&Path>) -> std::process::Ou
 fn export_ok(file: &Path, out: &Path, reference: Option<&Path>) {
     let o = export(file, out, reference);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-}
-
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let p = e.unwrap().path();
-            (
-                p.file_name().unwrap().to_string_lossy().into_owned(),
-                std::fs::read(&p).unwrap(),
-            )
-        })
-        .collect()
 }
 
 /// What the Python reader must find in each dataset of the series.

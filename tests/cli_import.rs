@@ -490,29 +490,17 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
             extra.to_str().unwrap(),
         ],
     ] {
-        let o = run_tdex(&args);
-        assert!(
-            o.status.success(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&o.stderr)
-        );
-        eprint!("{}", String::from_utf8_lossy(&o.stdout));
+        eprint!("{}", tdex_ok(&args));
     }
     let info = RecordingReader::open(&run).unwrap().info().clone();
     assert_eq!(
         (info.particles, info.period_steps, info.reference_periods),
         (500, 20000, 3)
     );
-    let text = run_tdex(&["compare", run.to_str().unwrap(), extra.to_str().unwrap()]);
-    eprint!("{}", String::from_utf8_lossy(&text.stdout));
-    let o = run_tdex(&[
-        "compare",
-        run.to_str().unwrap(),
-        extra.to_str().unwrap(),
-        "--json",
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    eprint!("{}", tdex_ok(&["compare", run_s, extra_s]));
+    let v: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["compare", run_s, extra_s, "--json"])).unwrap();
     let periods = v["periods"].as_array().unwrap();
     assert_eq!(periods.len(), 3);
     // what must hold whatever the cell errors (reported, not asserted, in

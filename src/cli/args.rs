@@ -32,27 +32,11 @@ pub enum Command {
     Record {
         /// The case file (TOML).
         case: PathBuf,
-        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// Period τ in seconds (default: one drum revolution).
-        #[arg(long, conflicts_with = "tau_rev")]
-        tau: Option<f64>,
-        /// Period τ as a fraction of a drum revolution.
-        #[arg(long = "tau-rev")]
-        tau_rev: Option<f64>,
-        /// Sampling factor n: the contact list is sampled every n DEM steps.
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
+        #[command(flatten)]
+        table: TableFlags,
         /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
         #[arg(long, default_value_t = 0)]
         reference: u32,
-        /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
-        #[arg(long = "exact-area")]
-        exact_area: bool,
         /// Worker threads (default: all cores). The recording does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -196,6 +180,29 @@ pub enum BenchCommand {
     },
 }
 
+/// The recording file and how its table is sampled: shared by `record` and `import`.
+#[derive(Debug, clap::Args)]
+pub struct TableFlags {
+    /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Period τ in seconds (default: one drum revolution).
+    #[arg(long, conflicts_with = "tau_rev")]
+    pub tau: Option<f64>,
+    /// Period τ as a fraction of a drum revolution.
+    #[arg(long = "tau-rev")]
+    pub tau_rev: Option<f64>,
+    /// Sampling factor n: the contact list is sampled every n DEM steps.
+    #[arg(long = "n", default_value_t = 10)]
+    pub n: u32,
+    /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
+    #[arg(long = "dtc-max", default_value_t = 100)]
+    pub dtc_max: u32,
+    /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
+    #[arg(long = "exact-area")]
+    pub exact_area: bool,
+}
+
 #[derive(Debug, Subcommand)]
 pub enum ImportCommand {
     /// A recording from LIGGGHTS text dumps: the atoms (`dump custom ... id type x y z vx vy
@@ -213,24 +220,8 @@ pub enum ImportCommand {
         /// The case file describing the run (time step, materials, conduction, drum).
         #[arg(long)]
         case: PathBuf,
-        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// Period τ in seconds (default: one drum revolution).
-        #[arg(long, conflicts_with = "tau_rev")]
-        tau: Option<f64>,
-        /// Period τ as a fraction of a drum revolution.
-        #[arg(long = "tau-rev")]
-        tau_rev: Option<f64>,
-        /// Sampling factor n: a multiple of the contact dumps' spacing (steps).
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
-        /// Store sqrt(a) as exact f64 instead of 16-bit codes.
-        #[arg(long = "exact-area")]
-        exact_area: bool,
+        #[command(flatten)]
+        table: TableFlags,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
         json: bool,

@@ -1,7 +1,7 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
 use super::args::{
-    BenchCommand, Cli, Command, ExportCommand, ImportCommand, StudyCommand, StudyCommon,
+    BenchCommand, Cli, Command, ExportCommand, ImportCommand, StudyCommand, StudyCommon, TableFlags,
 };
 use anyhow::Result;
 use extrapolate::replay::Scheme;
@@ -194,26 +194,19 @@ impl Plan {
             }
             Command::Record {
                 case,
-                output,
-                tau,
-                tau_rev,
-                n,
-                dtc_max,
+                table,
                 reference,
-                exact_area,
                 threads: t,
                 json,
             } => {
                 let threads = threads(t)?;
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options =
-                    record_options(&loaded, tau, tau_rev, n, dtc_max, reference, exact_area)?;
-                check_output(&output)?;
+                let options = table_options(&loaded, &table, reference)?;
                 Ok(Plan::Record(RecordPlan {
                     case_path: case,
                     case_toml,
                     case: loaded,
-                    output,
+                    output: table.output,
                     options,
                     threads,
                     json,
@@ -303,23 +296,17 @@ impl Plan {
                 atoms,
                 contacts,
                 case,
-                output,
-                tau,
-                tau_rev,
-                n,
-                dtc_max,
-                exact_area,
+                table,
                 json,
             }) => {
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = record_options(&loaded, tau, tau_rev, n, dtc_max, 0, exact_area)?;
-                check_output(&output)?;
+                let options = table_options(&loaded, &table, 0)?;
                 Ok(Plan::ImportLiggghts(ImportPlan {
                     dumps: recorder::import::liggghts::Dumps { atoms, contacts },
                     case_path: case,
                     case_toml,
                     case: loaded,
-                    output,
+                    output: table.output,
                     options,
                     json,
                 }))
@@ -369,6 +356,22 @@ impl Plan {
 
 fn usage(message: String) -> anyhow::Error {
     UsageError(message).into()
+}
+
+/// The recording settings of `record` and `import` checked against the case, and their
+/// output file.
+fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<RecordOptions> {
+    let options = record_options(
+        case,
+        t.tau,
+        t.tau_rev,
+        t.n,
+        t.dtc_max,
+        reference,
+        t.exact_area,
+    )?;
+    check_output(&t.output)?;
+    Ok(options)
 }
 
 /// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.
