@@ -4,8 +4,6 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use std::collections::BTreeMap;
-use std::path::Path;
 
 const PLOTS: [&str; 5] = [
     "means.svg",
