@@ -5,7 +5,9 @@ mod bench;
 mod cli;
 mod compare;
 mod demo;
+mod export;
 mod extrapolation;
+mod import;
 mod inspect;
 mod pair;
 mod progress;
@@ -43,6 +45,8 @@ fn main() -> ExitCode {
         cli::Plan::Report(p) => report::run(&p),
         cli::Plan::Demo(p) => demo::run(&p),
         cli::Plan::Study(p) => study::run(&p),
+        cli::Plan::ImportLiggghts(p) => import::run(&p),
+        cli::Plan::ExportVtk(p) => export::run(&p),
     });
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -54,6 +58,8 @@ fn main() -> ExitCode {
                     || e.is::<extrapolate::replay::ReplayError>()
                     || e.is::<extrapolate::pairing::PairingError>()
                     || e.downcast_ref::<recorder::format::FormatError>()
+                        .is_some_and(|f| f.is_bad_input())
+                    || e.downcast_ref::<recorder::import::ImportError>()
                         .is_some_and(|f| f.is_bad_input())
             };
             if err.chain().any(bad_input) {

@@ -8,7 +8,11 @@ use std::path::{Path, PathBuf};
 
 /// A tiny recording (τ = 0.25 rev, reference `reference` periods) and its extrapolation
 /// over `periods` periods.
-fn record_and_extrapolate(dir: &Path, reference: u32, periods: u32) -> (PathBuf, PathBuf) {
+pub(crate) fn record_and_extrapolate(
+    dir: &Path,
+    reference: u32,
+    periods: u32,
+) -> (PathBuf, PathBuf) {
     let case = dir.join("case.toml");
     std::fs::write(&case, TINY_CASE).unwrap();
     let run = dir.join("run.mcap");

@@ -156,17 +156,7 @@ fn the_recording_is_byte_identical_whatever_the_thread_count_up_to_its_costs() {
 
 #[test]
 fn the_python_mcap_reader_decodes_every_batch_and_snapshot() {
-    let python_ok = std::process::Command::new("python3")
-        .args(["-c", "import mcap, mcap_protobuf"])
-        .status()
-        .is_ok_and(|s| s.success());
-    if !python_ok {
-        // CI installs the readers and sets TDEX_REQUIRE_PYTHON so that this cannot pass silently
-        assert!(
-            std::env::var_os("TDEX_REQUIRE_PYTHON").is_none(),
-            "python3 with mcap and mcap-protobuf-support is required"
-        );
-        eprintln!("skipped: pip install mcap mcap-protobuf-support to run it");
+    if !python_with("mcap, mcap_protobuf", "mcap mcap-protobuf-support") {
         return;
     }
     let dir = tempfile::tempdir().unwrap();

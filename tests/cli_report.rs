@@ -4,8 +4,6 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use std::collections::BTreeMap;
-use std::path::Path;
 
 const PLOTS: [&str; 5] = [
     "means.svg",
@@ -14,30 +12,6 @@ const PLOTS: [&str; 5] = [
     "duration_cdf.svg",
     "field.svg",
 ];
-
-fn tdex_ok(args: &[&str]) -> String {
-    let o = run_tdex(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).unwrap()
-}
-
-/// Every file of `dir` by name, with its bytes.
-fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| {
-            let e = e.unwrap();
-            (
-                e.file_name().to_string_lossy().into_owned(),
-                std::fs::read(e.path()).unwrap(),
-            )
-        })
-        .collect()
-}
 
 /// The targets of the Markdown links and images `[..](target)`.
 fn markdown_links(md: &str) -> Vec<String> {

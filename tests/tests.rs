@@ -5,6 +5,8 @@ mod util;
 
 mod cli_case_errors;
 mod cli_compare;
+mod cli_export;
+mod cli_import;
 mod cli_record;
 mod cli_report;
 mod cli_run;

@@ -95,6 +95,49 @@ pub fn repo() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Runs tdex, asserting success; returns its stdout.
+pub fn tdex_ok(args: &[&str]) -> String {
+    let o = run_tdex(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8(o.stdout).unwrap()
+}
+
+/// Every file of `dir` by name, with its bytes.
+pub fn files(dir: &Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                std::fs::read(e.path()).unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// Whether python3 can `import modules`; if not, the test is skipped with a message, unless
+/// TDEX_REQUIRE_PYTHON is set (CI installs `packages` and sets it, so that a test cannot pass
+/// by skipping), when it fails.
+pub fn python_with(modules: &str, packages: &str) -> bool {
+    let ok = std::process::Command::new("python3")
+        .args(["-c", &format!("import {modules}")])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        assert!(
+            std::env::var_os("TDEX_REQUIRE_PYTHON").is_none(),
+            "python3 with {packages} is required (TDEX_REQUIRE_PYTHON is set)"
+        );
+        eprintln!("skipped: pip install {packages} to run it");
+    }
+    ok
+}
+
 pub fn run_tdex(args: &[&str]) -> Output {
     std::process::Command::new(tdex())
         .args(args)

@@ -1,15 +1,19 @@
 //! tdex recorder: case files, the thermal DEM engine of a rotating drum, the collision
-//! recorder and its file format.
+//! recorder and its file format, LIGGGHTS import and VTK export.
 //!
 //! Stages follow a DEM step: [`neighbor`] (cell grid, Verlet list), [`contact`] (one file per
 //! force law or pair kind), [`wall`], [`heat`] (conduction), [`integrate`], tied together by
 //! [`pipeline`]; [`counters`] times each stage. [`simulation`] drives a whole drum case.
+//! [`record`] samples the contacts into the table that [`format`] writes; [`import`] builds
+//! the same recording from LIGGGHTS dumps and [`export`] writes files for ParaView.
 
 pub mod case;
 pub mod contact;
 pub mod counters;
+pub mod export;
 pub mod format;
 pub mod heat;
+pub mod import;
 pub mod insertion;
 pub mod integrate;
 pub mod math;

@@ -76,7 +76,11 @@ pub struct PermuteScratch {
 }
 
 /// `field[i] = old[order[i]]`, through `scratch` (which then holds the old order).
-pub fn permute_field<T: Copy + Send + Sync>(field: &mut Vec<T>, order: &[u32], scratch: &mut Vec<T>) {
+pub fn permute_field<T: Copy + Send + Sync>(
+    field: &mut Vec<T>,
+    order: &[u32],
+    scratch: &mut Vec<T>,
+) {
     order
         .par_iter()
         .with_min_len(4096)

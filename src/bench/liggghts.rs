@@ -216,6 +216,9 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         ("period", case.drum.rotation_period.to_string()),
         ("nspin", case.steps_in(case.time.spin_up).to_string()),
         ("nheat", heating_steps.to_string()),
+        // the import test's dumps (tests/liggghts/deck_from_case.py --dumps) are not timed here
+        ("pair_compute", String::new()),
+        ("heat_runs", format!("run {heating_steps}")),
         ("ax", ["x", "y", "z"][axis].into()),
         ("ext", ext.to_string()),
         ("tmp_block", block("${mid}")),

@@ -32,27 +32,11 @@ pub enum Command {
     Record {
         /// The case file (TOML).
         case: PathBuf,
-        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// Period τ in seconds (default: one drum revolution).
-        #[arg(long, conflicts_with = "tau_rev")]
-        tau: Option<f64>,
-        /// Period τ as a fraction of a drum revolution.
-        #[arg(long = "tau-rev")]
-        tau_rev: Option<f64>,
-        /// Sampling factor n: the contact list is sampled every n DEM steps.
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
+        #[command(flatten)]
+        table: TableFlags,
         /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
         #[arg(long, default_value_t = 0)]
         reference: u32,
-        /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
-        #[arg(long = "exact-area")]
-        exact_area: bool,
         /// Worker threads (default: all cores). The recording does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -148,6 +132,12 @@ pub enum Command {
     /// on the rotating, heated phase of a case (optionally against LIGGGHTS in the same run);
     /// `tdex bench record CASE` the recording overhead.
     Bench(BenchArgs),
+    /// Build a recording from another DEM engine's output (docs/liggghts.md).
+    #[command(subcommand)]
+    Import(ImportCommand),
+    /// Write a recording or an extrapolation for other tools.
+    #[command(subcommand)]
+    Export(ExportCommand),
     /// Parameter studies (Haydar §3.2–3.3): sampling (n, Δt_c^max), pairing period τ, and
     /// flow regimes (drum speed), each recorded, extrapolated and compared with the DEM.
     #[command(subcommand)]
@@ -216,6 +206,71 @@ pub enum BenchCommand {
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
         json: bool,
+    },
+}
+
+/// The recording file and how its table is sampled: shared by `record` and `import`.
+#[derive(Debug, clap::Args)]
+pub struct TableFlags {
+    /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Period τ in seconds (default: one drum revolution).
+    #[arg(long, conflicts_with = "tau_rev")]
+    pub tau: Option<f64>,
+    /// Period τ as a fraction of a drum revolution.
+    #[arg(long = "tau-rev")]
+    pub tau_rev: Option<f64>,
+    /// Sampling factor n: the contact list is sampled every n DEM steps.
+    #[arg(long = "n", default_value_t = 10)]
+    pub n: u32,
+    /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
+    #[arg(long = "dtc-max", default_value_t = 100)]
+    pub dtc_max: u32,
+    /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
+    #[arg(long = "exact-area")]
+    pub exact_area: bool,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ImportCommand {
+    /// A recording from LIGGGHTS text dumps: the atoms (`dump custom ... id type x y z vx vy
+    /// vz radius f_Temp`) at t0, t1 = t0 + τ and every later t_k, and the contacts
+    /// (`compute pair/gran/local id contactArea` through `dump local`) every n steps of the
+    /// period; the same table and snapshots as `tdex record` (docs/liggghts.md).
+    Liggghts {
+        /// The atom dump files: a path or a pattern (`*`, `%`, `?` in the file name; quote it),
+        /// plain or gzip, several timesteps and MPI processes merged by timestep.
+        #[arg(long)]
+        atoms: String,
+        /// The contact dump files (`dump local`), as --atoms.
+        #[arg(long)]
+        contacts: String,
+        /// The case file describing the run (time step, materials, conduction, drum).
+        #[arg(long)]
+        case: PathBuf,
+        #[command(flatten)]
+        table: TableFlags,
+        /// Print the summary as one JSON object on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum ExportCommand {
+    /// ParaView files: one VTK PolyData file (.vtp) per snapshot with temperature, radius, id
+    /// and velocity, and a .pvd time series that opens them all.
+    Vtk {
+        /// A recording or an extrapolation (MCAP).
+        file: PathBuf,
+        /// The directory for the files (created if missing; files of the same name replaced).
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
+        /// For an extrapolation: its recording, to add the DEM − extrapolated temperature
+        /// differences at every t_k that has a DEM reference.
+        #[arg(long)]
+        reference: Option<PathBuf>,
     },
 }
 

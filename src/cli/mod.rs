@@ -6,6 +6,7 @@ mod plan;
 pub use args::Cli;
 pub(crate) use plan::record_options;
 pub use plan::{
-    BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExtrapolatePlan, InspectPlan, PairPlan,
-    Plan, RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan, UsageError,
+    BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExportVtkPlan, ExtrapolatePlan, ImportPlan,
+    InspectPlan, PairPlan, Plan, RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan,
+    UsageError,
 };

@@ -1,6 +1,9 @@
 //! Validated plans: every flag and the case file are checked here, before any simulation starts.
 
-use super::args::{BenchArgs, BenchCommand, Cli, Command, StudyCommand, StudyCommon};
+use super::args::{
+    BenchArgs, BenchCommand, Cli, Command, ExportCommand, ImportCommand, StudyCommand, StudyCommon,
+    TableFlags,
+};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::format::AreaEncoding;
@@ -33,6 +36,27 @@ pub enum Plan {
     Report(ReportPlan),
     Demo(DemoPlan),
     Study(StudyPlan),
+    ImportLiggghts(ImportPlan),
+    ExportVtk(ExportVtkPlan),
+}
+
+/// `tdex import liggghts`: the dumps, the case describing the run and the recording settings
+/// (`reference_periods` is found in the dumps).
+pub struct ImportPlan {
+    pub dumps: recorder::import::liggghts::Dumps,
+    pub case_path: PathBuf,
+    pub case_toml: String,
+    pub case: Case,
+    pub output: PathBuf,
+    pub options: RecordOptions,
+    pub json: bool,
+}
+
+/// `tdex export vtk`.
+pub struct ExportVtkPlan {
+    pub file: PathBuf,
+    pub output: PathBuf,
+    pub reference: Option<PathBuf>,
 }
 
 /// `tdex study ...`: the case, the study directory and what to run.
@@ -183,26 +207,19 @@ impl Plan {
             }
             Command::Record {
                 case,
-                output,
-                tau,
-                tau_rev,
-                n,
-                dtc_max,
+                table,
                 reference,
-                exact_area,
                 threads: t,
                 json,
             } => {
                 let threads = threads(t)?;
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options =
-                    record_options(&loaded, tau, tau_rev, n, dtc_max, reference, exact_area)?;
-                check_output(&output)?;
+                let options = table_options(&loaded, &table, reference)?;
                 Ok(Plan::Record(RecordPlan {
                     case_path: case,
                     case_toml,
                     case: loaded,
-                    output,
+                    output: table.output,
                     options,
                     threads,
                     json,
@@ -288,6 +305,37 @@ impl Plan {
                 Ok(Plan::Demo(DemoPlan { output, threads }))
             }
             Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
+            Command::Import(ImportCommand::Liggghts {
+                atoms,
+                contacts,
+                case,
+                table,
+                json,
+            }) => {
+                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
+                let options = table_options(&loaded, &table, 0)?;
+                Ok(Plan::ImportLiggghts(ImportPlan {
+                    dumps: recorder::import::liggghts::Dumps { atoms, contacts },
+                    case_path: case,
+                    case_toml,
+                    case: loaded,
+                    output: table.output,
+                    options,
+                    json,
+                }))
+            }
+            Command::Export(ExportCommand::Vtk {
+                file,
+                output,
+                reference,
+            }) => {
+                check_output_dir(&output)?;
+                Ok(Plan::ExportVtk(ExportVtkPlan {
+                    file,
+                    output,
+                    reference,
+                }))
+            }
             Command::Bench(BenchArgs {
                 command: None,
                 case: Some(case),
@@ -354,6 +402,22 @@ impl Plan {
 
 fn usage(message: String) -> anyhow::Error {
     UsageError(message).into()
+}
+
+/// The recording settings of `record` and `import` checked against the case, and their
+/// output file.
+fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<RecordOptions> {
+    let options = record_options(
+        case,
+        t.tau,
+        t.tau_rev,
+        t.n,
+        t.dtc_max,
+        reference,
+        t.exact_area,
+    )?;
+    check_output(&t.output)?;
+    Ok(options)
 }
 
 /// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.
@@ -454,7 +518,7 @@ fn check_cells(cells: usize) -> Result<()> {
     Ok(())
 }
 
-/// A report directory: an existing directory, or a new one whose parent exists.
+/// An output directory: an existing directory, or a new one whose parent exists.
 fn check_output_dir(dir: &std::path::Path) -> Result<()> {
     check_dir("-o", dir, "the output")
 }

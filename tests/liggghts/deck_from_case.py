@@ -1,13 +1,21 @@
 #!/usr/bin/env python3
 """Write a LIGGGHTS 3.8 deck and the drum STL for a tdex case file.
 
-usage: deck_from_case.py CASE.toml OUTDIR
+usage: deck_from_case.py CASE.toml OUTDIR [--dumps N PERIODS [--per-proc]]
 
 Writes OUTDIR/in.drum (every value of the case substituted, paths relative to
 OUTDIR: run it from there) and the drum mesh: OUTDIR/drum.stl (mantle + both end
 caps, one rotating mesh) or, with `end_caps = "fixed"`, drum_mantle.stl and
 drum_caps.stl.  Drum axis y through the origin, gravity -z, type 1 = particles,
 type 2 = wall (same E, nu, k, c as the particles).  Python stdlib only.
+
+With --dumps N PERIODS the heating phase is 1 + PERIODS drum revolutions and the deck
+writes the dumps `tdex import liggghts` reads (docs/liggghts.md): the atoms at t0 and
+after every revolution (dump_atoms.STEP) and the contacts every N steps during the
+first revolution (dump_pairs.STEP); with --per-proc the atoms go to one file per MPI
+process and timestep (dump_atoms.STEP.PROC; LIGGGHTS 3.8 writes no header in the `dump local`
+files of processes other than 0, so the contacts are always gathered into one file).  t0 must then be a whole number of revolutions and
+of N steps (choose time.settle + time.spin_up accordingly).
 """
 import math
 import re
@@ -65,8 +73,33 @@ def steps(seconds, dt, what):
 DECK = (Path(__file__).resolve().parents[2] / "src" / "bench" / "liggghts_deck.in").read_text()
 
 
+IMPORT_DUMPS = """\
+# the dumps of `tdex import liggghts` (docs/liggghts.md): atoms at t0 and every revolution,
+# contacts every @n@ steps during the recorded revolution, then @periods@ revolutions of reference
+dump da all custom @nper@ dump_atoms.*@proc@ id type x y z vx vy vz radius f_Temp
+dump_modify da format "%d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g"
+dump dc all local @n@ dump_pairs.* c_pc[1] c_pc[2] c_pc[3] c_pc[4]
+dump_modify dc format "%.0f %.0f %.0f %.17g"
+run @nper@
+undump dc
+run @nrest@"""
+
+
+def import_dumps(argv, nper, nstart):
+    """The heating runs of a deck that writes the import dumps (--dumps N PERIODS [--per-proc])."""
+    if len(argv) not in (3, 4) or argv[0] != "--dumps" or argv[3:] not in ([], ["--per-proc"]):
+        sys.exit(__doc__)
+    n, periods = int(argv[1]), int(argv[2])
+    if n < 1 or periods < 0 or nper % n or nstart % nper:
+        sys.exit(f"--dumps {n} {periods}: t0 = step {nstart} must be a multiple of one revolution "
+                 f"({nper} steps), itself a multiple of n = {n}")
+    v = dict(n=n, periods=periods, nper=nper, nrest=periods * nper,
+             proc=".%" if argv[3:] else "")
+    return re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), IMPORT_DUMPS)
+
+
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) < 3 or (len(sys.argv) > 3 and sys.argv[3] != "--dumps"):
         sys.exit(__doc__)
     case_path, out = Path(sys.argv[1]), Path(sys.argv[2])
     c = tomllib.loads(case_path.read_text())
@@ -124,6 +157,11 @@ def main():
         nheat=steps(t.get("heating") or drum["rotation_period"], dt, "time.heating"),
         ax=ax, ext=ext, tmp_block=" ".join(blocks["tmp"]), hot_block=" ".join(blocks["hot"]),
     )
+    nper = steps(drum["rotation_period"], dt, "drum.rotation_period")
+    # LIGGGHTS wants compute pair/gran/local defined before the first run
+    v["pair_compute"] = "compute pc all pair/gran/local id contactArea" if len(sys.argv) > 3 else ""
+    v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"])
+                      if len(sys.argv) > 3 else f"run {v['nheat']}")
     deck = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), DECK)
     (out / "in.drum").write_text(deck)
     print(f"wrote {out}/in.drum: N={v['N']} R={R} L={L} settle={v['nsettle']} spin={v['nspin']} "

@@ -192,8 +192,7 @@ impl NeighborList {
 
         let blocks = || (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
         let (offsets, wall_offsets) = (&self.offsets, &self.wall_offsets);
-        let entry_bounds =
-            || blocks().map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize));
+        let entry_bounds = || blocks().map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize));
         let wall_bounds =
             || blocks().map(|(lo, hi)| (wall_offsets[lo] as usize, wall_offsets[hi] as usize));
         let (ids, carried) = (&particles.id, &self.carried);
@@ -212,9 +211,7 @@ impl NeighborList {
                     search.partners(i, |j, now_touching| {
                         // a history matters only to a pair touching now (the pair stage's
                         // own test): it resets the others
-                        let h = now_touching
-                            .then(|| carried.pair(ids[i], ids[j]))
-                            .flatten();
+                        let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
                         partner[e] = j as u32;
                         history[e] = h.unwrap_or_default();
                         touch[e] = h.is_some();

@@ -7,6 +7,8 @@ use crate::format::{
     AreaEncoding, FormatError, RecordingCosts, RecordingInfo, RecordingSummary, RecordingWriter,
     WallInfo, FORMAT_VERSION, SQRT_AREA_CODES,
 };
+use crate::heat::ConductionLaw;
+use crate::wall::WallSet;
 use crate::{Simulation, SimulationError};
 use std::path::Path;
 use std::sync::mpsc;
@@ -170,7 +172,15 @@ pub fn record_many_from_t0(
     let t0 = sim.snapshot(0);
     let mut writers = Vec::with_capacity(jobs.len());
     for j in jobs {
-        let info = recording_info(sim, case_path, case_toml, &j.options);
+        let particles = sim.particles.len() as u32;
+        let run = RunAtT0 {
+            particles,
+            r_max: sim.particles.radius.iter().cloned().fold(0.0, f64::max),
+            walls: wall_infos(&sim.walls, particles),
+            t0: sim.time,
+            step_t0: sim.step,
+        };
+        let info = recording_info(&sim.case, case_path, case_toml, &j.options, run);
         let mut writer = RecordingWriter::create(j.dest, info)?;
         writer.write_snapshot(&t0)?;
         writers.push(writer);
@@ -311,47 +321,72 @@ fn record_period(
     })
 }
 
-fn recording_info(
-    sim: &Simulation,
+/// What a recording's info takes from the run at `t0`, whichever engine made it.
+pub(crate) struct RunAtT0 {
+    pub particles: u32,
+    /// Largest particle radius (m): the span of the `sqrt(a)` codes.
+    pub r_max: f64,
+    pub walls: Vec<WallInfo>,
+    /// Simulated time and step count at `t0`.
+    pub t0: f64,
+    pub step_t0: u64,
+}
+
+/// The walls of the case's drum as table bodies `particles + w`, with their fixed
+/// temperature when they conduct.
+pub(crate) fn wall_infos(walls: &WallSet, particles: u32) -> Vec<WallInfo> {
+    let kinds = ["mantle", "cap_low", "cap_high"];
+    (0..walls.len())
+        .map(|w| WallInfo {
+            id: particles + w as u32,
+            kind: kinds.get(w).copied().unwrap_or("wall").into(),
+            temperature: walls.temperature(w),
+        })
+        .collect()
+}
+
+/// The `tdex.recording` metadata of a period recorded with `opts` from `run`; the material
+/// and conduction constants come from the case, as the engine resolves them.
+pub(crate) fn recording_info(
+    case: &Case,
     case_path: &Path,
     case_toml: &str,
     opts: &RecordOptions,
+    run: RunAtT0,
 ) -> RecordingInfo {
-    let case = &sim.case;
-    let particles = sim.particles.len() as u32;
-    let r_max = sim.particles.radius.iter().cloned().fold(0.0, f64::max);
-    let kinds = ["mantle", "cap_low", "cap_high"];
+    let m = &case.material;
+    let law = ConductionLaw::new(
+        &case.conduction,
+        m.conductivity,
+        case.drum.wall_conductivity.unwrap_or(m.conductivity),
+        m.heat_capacity,
+        m.youngs_modulus,
+    );
     RecordingInfo {
         format_version: FORMAT_VERSION,
         tool_version: env!("CARGO_PKG_VERSION").into(),
         case_toml: case_toml.into(),
         case_path: case_path.display().to_string(),
         case_resolved: serde_json::to_value(case).expect("a case serialises"),
-        particles,
-        walls: (0..sim.walls.len())
-            .map(|w| WallInfo {
-                id: particles + w as u32,
-                kind: kinds.get(w).copied().unwrap_or("wall").into(),
-                temperature: sim.walls.temperature(w),
-            })
-            .collect(),
-        dt: sim.params.dt,
+        particles: run.particles,
+        walls: run.walls,
+        dt: case.time.dt,
         sample_every: opts.sample_every,
         dtc_max_steps: opts.dtc_max_steps,
         period_steps: opts.period_steps,
-        tau: opts.period_steps as f64 * sim.params.dt,
-        t0: sim.time,
-        step_t0: sim.step,
+        tau: opts.period_steps as f64 * case.time.dt,
+        t0: run.t0,
+        step_t0: run.step_t0,
         reference_periods: opts.reference_periods,
         area_encoding: opts.area_encoding,
         sqrt_area_unit: match opts.area_encoding {
-            AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * r_max / SQRT_AREA_CODES,
+            AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * run.r_max / SQRT_AREA_CODES,
             AreaEncoding::Exact => 0.0,
         },
-        pair_conductivity: sim.params.conduction.pair_conductivity,
-        wall_conductivity: sim.params.conduction.wall_conductivity,
-        density: case.material.density,
-        heat_capacity: case.material.heat_capacity,
-        conductivity: case.material.conductivity,
+        pair_conductivity: law.pair_conductivity,
+        wall_conductivity: law.wall_conductivity,
+        density: m.density,
+        heat_capacity: m.heat_capacity,
+        conductivity: m.conductivity,
     }
 }

@@ -1,0 +1,125 @@
+//! `tdex export vtk`: every snapshot of a recording or an extrapolation as a VTK PolyData
+//! file, and a `.pvd` series that ParaView opens in one click.
+
+use crate::cli::{ExportVtkPlan, UsageError};
+use anyhow::{Context, Result};
+use recorder::export::vtk::{self, ExtraArray};
+use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
+use std::path::{Path, PathBuf};
+
+/// Name of the per-particle difference array of an extrapolation with its reference.
+pub const DIFFERENCE: &str = "dem_minus_extrapolated";
+
+pub fn run(plan: &ExportVtkPlan) -> Result<()> {
+    for f in write(plan)? {
+        println!("{}", f.display());
+    }
+    Ok(())
+}
+
+/// Writes the `.vtp` files, then the `.pvd` (each through a temporary file renamed into
+/// place, the series last); returns the files written.
+pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
+    let (snapshots, reference) = match open(&plan.file)? {
+        Opened::Recording(r) => {
+            if plan.reference.is_some() {
+                return Err(UsageError(format!(
+                    "--reference: {} is a recording; the DEM − extrapolated difference needs \
+                     an extrapolation and its recording",
+                    plan.file.display()
+                ))
+                .into());
+            }
+            (r.snapshots()?, Vec::new())
+        }
+        Opened::Extrapolation(e) => {
+            let reference = match &plan.reference {
+                Some(path) => {
+                    let rec = RecordingReader::open(path)?;
+                    if e.info().recording_info != *rec.info() {
+                        return Err(UsageError(format!(
+                            "--reference {}: {} was not extrapolated from it (it names {})",
+                            path.display(),
+                            plan.file.display(),
+                            e.info().recording
+                        ))
+                        .into());
+                    }
+                    rec.snapshots()?
+                }
+                None => Vec::new(),
+            };
+            (e.snapshots()?, reference)
+        }
+    };
+    let stem = plan
+        .file
+        .file_stem()
+        .map_or("tdex".into(), |s| s.to_string_lossy().into_owned());
+    std::fs::create_dir_all(&plan.output)
+        .with_context(|| format!("{}: cannot create the directory", plan.output.display()))?;
+    let mut written = Vec::new();
+    let mut series = Vec::new();
+    for snap in &snapshots {
+        let name = format!("{stem}_{:04}.vtp", snap.index);
+        let difference = reference
+            .iter()
+            .find(|r| r.index == snap.index)
+            .map(|dem| dem_minus_extrapolated(dem, snap));
+        let extra: Vec<ExtraArray> = difference
+            .iter()
+            .map(|values| ExtraArray {
+                name: DIFFERENCE,
+                values,
+            })
+            .collect();
+        let xml = vtk::polydata(snap, &extra);
+        written.push(crate::report::write_atomically(
+            &plan.output,
+            &name,
+            xml.as_bytes(),
+        )?);
+        series.push((snap.time, name));
+    }
+    let pvd = format!("{stem}.pvd");
+    written.push(crate::report::write_atomically(
+        &plan.output,
+        &pvd,
+        vtk::collection(&series).as_bytes(),
+    )?);
+    Ok(written)
+}
+
+enum Opened {
+    Recording(RecordingReader),
+    Extrapolation(ExtrapolationReader),
+}
+
+/// A recording or, failing that, an extrapolation.
+fn open(path: &Path) -> Result<Opened> {
+    match RecordingReader::open(path) {
+        Ok(r) => Ok(Opened::Recording(r)),
+        Err(FormatError::NotRecording { .. }) => match ExtrapolationReader::open(path) {
+            Ok(e) => Ok(Opened::Extrapolation(e)),
+            Err(FormatError::NotRecording { path, .. }) => Err(FormatError::NotRecording {
+                path,
+                expected: "recording or extrapolation",
+                detail: "it has neither tdex metadata record".into(),
+            }
+            .into()),
+            Err(e) => Err(e.into()),
+        },
+        Err(e) => Err(e.into()),
+    }
+}
+
+/// Per point of an extrapolated snapshot, the DEM temperature of the particle playing its
+/// role (`id`) minus the extrapolated one.
+fn dem_minus_extrapolated(dem: &Snapshot, extra: &Snapshot) -> Vec<f64> {
+    extra
+        .id
+        .iter()
+        .zip(&extra.temp)
+        .map(|(&id, t)| dem.temp[id as usize] - t)
+        .collect()
+}
