@@ -88,3 +88,158 @@ fn results_are_bit_identical_with_one_and_two_threads() {
     assert!(a.contacts_per_particle() > 1.0);
     assert!(pa.temp.iter().any(|&t| t != 30.0 && t != 10.0));
 }
+
+/// The pair stage evaluates each pair once and hands `j` the opposite force, its own
+/// lever-arm torque and the opposite heat flow. Checked against the definition: every
+/// particle evaluates the law from its own side over all its touching partners (what a
+/// full-list engine does), with histories taken from the list (reversed for the partner).
+#[test]
+fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
+    use recorder::contact::contact_sphere_sphere::{self as ss, SphereState};
+    use recorder::contact::{contact_sphere_wall as sw, hertz_mindlin};
+    use recorder::math::*;
+    use recorder::pipeline::{pair_interactions, wall_interactions};
+
+    let case = small_drum();
+    let mut sim = Simulation::new(&case).unwrap();
+    let mut quiet = |_| {};
+    sim.run(case.steps_in(case.time.settle), 1000, &mut quiet)
+        .unwrap();
+    sim.start_rotation();
+    sim.assign_temperatures();
+    sim.run(2000, 1000, &mut quiet).unwrap();
+
+    let before = sim.clone();
+    let (p, list, params) = (&before.particles, &before.neighbors, &before.params);
+    let n = p.len();
+    let state = |i: usize| SphereState {
+        pos: p.pos[i],
+        vel: p.vel[i],
+        omega: p.omega[i],
+        radius: p.radius[i],
+        mass: p.mass[i],
+    };
+    let (mut force, mut torque, mut heat) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n], vec![0.0; n]);
+    let mut from_side = |i: usize, j: usize, history: recorder::contact::ContactHistory| {
+        let delta = sub(p.pos[i], p.pos[j]);
+        let Some(r2) = ss::overlapping(delta, p.radius[i], p.radius[j]) else {
+            return;
+        };
+        let eff = ss::effective(p.radius[i], p.radius[j], p.mass[i], p.mass[j]);
+        let c = ss::kinematics(&state(i), &state(j), delta, r2, eff);
+        let mut h = history;
+        let resp =
+            hertz_mindlin::respond(&params.particle_particle, &c.kinematics, &mut h, params.dt);
+        force[i] = add(force[i], resp.force);
+        torque[i] = add(torque[i], resp.torque_on_i(c.lever_i));
+        let conductance = params
+            .conduction
+            .pair_conductance(c.distance, p.radius[i], p.radius[j]);
+        heat[i] += conductance * (p.temp[j] - p.temp[i]);
+    };
+    let mut pairs = 0;
+    for i in 0..n {
+        for e in list.range(i) {
+            let j = list.neighbors[e] as usize;
+            from_side(i, j, list.history[e]);
+            from_side(j, i, list.history[e].reversed());
+            pairs += list.touching[e] as usize;
+        }
+    }
+    for i in 0..n {
+        for e in list.wall_range(i) {
+            let w = list.wall_index[e] as usize;
+            if let Some(c) = before.walls.contact(w, p.pos[i], p.radius[i]) {
+                let (kin, lever) = sw::kinematics(&state(i), &c);
+                let mut h = list.wall_history[e];
+                let resp = hertz_mindlin::respond(&params.particle_wall, &kin, &mut h, params.dt);
+                force[i] = add(force[i], resp.force);
+                torque[i] = add(torque[i], resp.torque_on_i(lever));
+            }
+        }
+    }
+    assert!(
+        pairs > n,
+        "the bed should be in contact: {pairs} touching pairs"
+    );
+
+    let mut after = before.clone();
+    pair_interactions(&after.params, &mut after.particles, &mut after.neighbors);
+    wall_interactions(
+        &after.params,
+        &mut after.particles,
+        &mut after.neighbors,
+        &after.walls,
+    );
+    let scale_f = force.iter().map(|f| norm2(*f).sqrt()).fold(0.0, f64::max);
+    let scale_t = torque.iter().map(|t| norm2(*t).sqrt()).fold(0.0, f64::max);
+    let scale_q = heat.iter().map(|q| q.abs()).fold(0.0, f64::max);
+    for i in 0..n {
+        let q = &after.particles;
+        let df = norm2(sub(q.force[i], force[i])).sqrt() / scale_f;
+        let dt = norm2(sub(q.torque[i], torque[i])).sqrt() / scale_t;
+        let dq = (q.heat_flow[i] - heat[i]).abs() / scale_q;
+        assert!(
+            df < 1e-12 && dt < 1e-12 && dq < 1e-12,
+            "slot {i}: force {:?} vs {:?}, torque {:?} vs {:?}, heat {} vs {}",
+            q.force[i],
+            force[i],
+            q.torque[i],
+            torque[i],
+            q.heat_flow[i],
+            heat[i]
+        );
+    }
+}
+
+/// A rebuild re-sorts the particles and rebuilds the lists; every open contact keeps its
+/// springs, seen from whichever particle now owns the entry.
+#[test]
+fn a_rebuild_keeps_every_open_contact_history() {
+    use recorder::contact::ContactHistory;
+    use std::collections::BTreeMap;
+
+    let case = small_drum();
+    let mut sim = Simulation::new(&case).unwrap();
+    let mut quiet = |_| {};
+    sim.run(case.steps_in(case.time.settle), 1000, &mut quiet)
+        .unwrap();
+    sim.start_rotation();
+    sim.run(3000, 1000, &mut quiet).unwrap();
+
+    // (smaller id, larger id or particles + wall) → springs seen from the smaller id
+    let open = |sim: &Simulation| {
+        let (p, list) = (&sim.particles, &sim.neighbors);
+        let mut map: BTreeMap<(u32, u32), ContactHistory> = BTreeMap::new();
+        for i in 0..p.len() {
+            for e in list.range(i).filter(|&e| list.touching[e]) {
+                let (a, b) = (p.id[i], p.id[list.neighbors[e] as usize]);
+                let h = list.history[e];
+                let key = (a.min(b), a.max(b));
+                map.insert(key, if a < b { h } else { h.reversed() });
+            }
+            for e in list.wall_range(i).filter(|&e| list.wall_touching[e]) {
+                let w = p.len() as u32 + list.wall_index[e] as u32;
+                map.insert((p.id[i], w), list.wall_history[e]);
+            }
+        }
+        map
+    };
+    let before = open(&sim);
+    assert!(
+        before.len() > sim.particles.len(),
+        "{} open contacts",
+        before.len()
+    );
+    assert!(before.values().any(|h| h.shear != [0.0; 3]));
+    let mut rebuilt = sim.clone();
+    let (grid, walls) = (rebuilt.pipeline.grid.clone(), rebuilt.walls.clone());
+    rebuilt
+        .neighbors
+        .rebuild(&mut rebuilt.particles, &grid, &walls);
+    assert_ne!(
+        rebuilt.particles.id, sim.particles.id,
+        "the re-sort moved particles"
+    );
+    assert_eq!(open(&rebuilt), before);
+}

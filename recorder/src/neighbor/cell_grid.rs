@@ -12,6 +12,9 @@ pub struct CellGrid {
     pub dims: [usize; 3],
     /// Axes from the fastest-varying index to the slowest (the layer axis).
     axes: [usize; 3],
+    /// Offsets `[dx, dy, dz]` of the cells at or after a cell in index order: its own and
+    /// the 13 ahead of it, the half stencil of a half list.
+    pub forward: [[i64; 3]; 14],
 }
 
 impl CellGrid {
@@ -26,12 +29,32 @@ impl CellGrid {
         // horizontal layers its bed only half fills
         let mut axes = [0, 1, 2];
         axes.sort_by_key(|&k| (dims[k], std::cmp::Reverse(k)));
+        let [a, b, l] = axes;
+        let mut forward = [[0i64; 3]; 14];
+        let mut k = 0;
+        // (slow, mid, fast) offsets in index order: the own cell, then the next along the
+        // fast axis, the next row, the next layer
+        for (dl, db_range, da_range) in [
+            (0i64, 0..=0i64, 0..=1i64),
+            (0, 1..=1, -1..=1),
+            (1, -1..=1, -1..=1),
+        ] {
+            for db in db_range {
+                for da in da_range.clone() {
+                    forward[k][a] = da;
+                    forward[k][b] = db;
+                    forward[k][l] = dl;
+                    k += 1;
+                }
+            }
+        }
         // cells stay ≥ min_cell: the box is widened to a whole number of them
         Self {
             origin: lo,
             cell_size: min_cell,
             dims,
             axes,
+            forward,
         }
     }
 
@@ -72,6 +95,33 @@ impl CellGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_forward_stencil_is_every_cell_ahead_within_one() {
+        let grid = CellGrid::new([0.0; 3], [5.0, 7.0, 4.0], 1.0);
+        let centre = [2usize, 3, 2];
+        let own = grid.index(centre) as i64;
+        let mut ahead: Vec<[i64; 3]> = Vec::new();
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let c = [
+                        centre[0] as i64 + dx,
+                        centre[1] as i64 + dy,
+                        centre[2] as i64 + dz,
+                    ];
+                    let i = grid.index([c[0] as usize, c[1] as usize, c[2] as usize]) as i64;
+                    if i >= own {
+                        ahead.push([dx, dy, dz]);
+                    }
+                }
+            }
+        }
+        let mut forward = grid.forward.to_vec();
+        forward.sort();
+        ahead.sort();
+        assert_eq!(forward, ahead);
+    }
 
     #[test]
     fn of_equal_axes_the_first_is_the_layer_axis() {

@@ -272,32 +272,28 @@ struct Search<'a> {
 }
 
 impl Search<'_> {
-    /// Calls `found(j, touching_now)` for every `j > i` within the skin, scanning the cells
-    /// around `i`'s own in a fixed order.
+    /// Calls `found(j, touching_now)` for every `j > i` within the skin, scanning `i`'s own
+    /// cell and the 13 after it in a fixed order (earlier cells hold only slots below `i`).
     #[inline(always)]
     fn partners(&self, i: usize, mut found: impl FnMut(usize, bool)) {
         let (grid, pos, radius) = (self.grid, self.pos, self.radius);
         let ci = grid.coords(pos[i]);
-        let own_cell = grid.index(ci);
-        for dz in -1i64..=1 {
-            for dy in -1i64..=1 {
-                for dx in -1i64..=1 {
-                    let c = [ci[0] as i64 + dx, ci[1] as i64 + dy, ci[2] as i64 + dz];
-                    if (0..3).any(|k| c[k] < 0 || c[k] >= grid.dims[k] as i64) {
-                        continue;
-                    }
-                    let cell = grid.index([c[0] as usize, c[1] as usize, c[2] as usize]);
-                    if cell < own_cell {
-                        continue;
-                    }
-                    let first = (self.cell_start[cell] as usize).max(i + 1);
-                    for j in first..self.cell_start[cell + 1] as usize {
-                        let cut = radius[i] + radius[j] + self.skin;
-                        let delta = sub(pos[i], pos[j]);
-                        if norm2(delta) < cut * cut {
-                            found(j, overlapping(delta, radius[i], radius[j]).is_some());
-                        }
-                    }
+        for d in &grid.forward {
+            let c = [
+                ci[0] as i64 + d[0],
+                ci[1] as i64 + d[1],
+                ci[2] as i64 + d[2],
+            ];
+            if (0..3).any(|k| c[k] < 0 || c[k] >= grid.dims[k] as i64) {
+                continue;
+            }
+            let cell = grid.index([c[0] as usize, c[1] as usize, c[2] as usize]);
+            let first = (self.cell_start[cell] as usize).max(i + 1);
+            for j in first..self.cell_start[cell + 1] as usize {
+                let cut = radius[i] + radius[j] + self.skin;
+                let delta = sub(pos[i], pos[j]);
+                if norm2(delta) < cut * cut {
+                    found(j, overlapping(delta, radius[i], radius[j]).is_some());
                 }
             }
         }
