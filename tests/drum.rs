@@ -7,16 +7,27 @@ fn small_drum() -> recorder::Case {
     recorder::case::load(&repo().join("cases/small_drum.toml")).expect("small_drum.toml is valid")
 }
 
-#[test]
-fn drum_heating_for_one_revolution_conserves_heat_and_mixes() {
+/// The small drum settled, then turning for `spin_steps` (temperatures assigned at the start
+/// of the turning when `heated`).
+fn turning_small_drum(spin_steps: u64, heated: bool) -> Simulation {
     let case = small_drum();
     let mut sim = Simulation::new(&case).unwrap();
     let mut quiet = |_| {};
     sim.run(case.steps_in(case.time.settle), 1000, &mut quiet)
         .unwrap();
     sim.start_rotation();
-    sim.run(case.steps_in(case.time.spin_up), 1000, &mut quiet)
-        .unwrap();
+    if heated {
+        sim.assign_temperatures();
+    }
+    sim.run(spin_steps, 1000, &mut quiet).unwrap();
+    sim
+}
+
+#[test]
+fn drum_heating_for_one_revolution_conserves_heat_and_mixes() {
+    let case = small_drum();
+    let mut sim = turning_small_drum(case.steps_in(case.time.spin_up), false);
+    let mut quiet = |_| {};
     sim.assign_temperatures();
     let start = sim.heat_summary();
     assert_eq!(
@@ -100,16 +111,7 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
     use recorder::math::*;
     use recorder::pipeline::{pair_interactions, wall_interactions};
 
-    let case = small_drum();
-    let mut sim = Simulation::new(&case).unwrap();
-    let mut quiet = |_| {};
-    sim.run(case.steps_in(case.time.settle), 1000, &mut quiet)
-        .unwrap();
-    sim.start_rotation();
-    sim.assign_temperatures();
-    sim.run(2000, 1000, &mut quiet).unwrap();
-
-    let before = sim.clone();
+    let before = turning_small_drum(2000, true);
     let (p, list, params) = (&before.particles, &before.neighbors, &before.params);
     let n = p.len();
     let state = |i: usize| SphereState {
@@ -199,14 +201,7 @@ fn a_rebuild_keeps_every_open_contact_history() {
     use recorder::contact::ContactHistory;
     use std::collections::BTreeMap;
 
-    let case = small_drum();
-    let mut sim = Simulation::new(&case).unwrap();
-    let mut quiet = |_| {};
-    sim.run(case.steps_in(case.time.settle), 1000, &mut quiet)
-        .unwrap();
-    sim.start_rotation();
-    sim.run(3000, 1000, &mut quiet).unwrap();
-
+    let sim = turning_small_drum(3000, false);
     // (smaller id, larger id or particles + wall) → springs seen from the smaller id
     let open = |sim: &Simulation| {
         let (p, list) = (&sim.particles, &sim.neighbors);
