@@ -123,18 +123,11 @@ pub fn pair_interactions(
         ..
     } = particles;
     let (pos, vel, omega, radius, mass, temp) = (&*pos, &*vel, &*omega, &*radius, &*mass, &*temp);
-    force
-        .par_iter_mut()
+    // the sums start from zero in one pass over the three accumulators
+    (&mut *force, &mut *torque, &mut *heat_flow)
+        .into_par_iter()
         .with_min_len(4096)
-        .for_each(|f| *f = [0.0; 3]);
-    torque
-        .par_iter_mut()
-        .with_min_len(4096)
-        .for_each(|t| *t = [0.0; 3]);
-    heat_flow
-        .par_iter_mut()
-        .with_min_len(4096)
-        .for_each(|q| *q = 0.0);
+        .for_each(|(f, t, q)| (*f, *t, *q) = ([0.0; 3], [0.0; 3], 0.0));
     let NeighborList {
         offsets,
         neighbors: partners,

@@ -254,11 +254,6 @@ impl NeighborList {
     pub fn wall_range(&self, i: usize) -> std::ops::Range<usize> {
         self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize
     }
-
-    /// The list entries in use (pairs, walls), for the memory figures.
-    pub fn entries(&self) -> (usize, usize) {
-        (self.neighbors.len(), self.wall_index.len())
-    }
 }
 
 /// The broad-phase search over particles already in cell order.
