@@ -2,7 +2,6 @@
 
 use crate::cli::RunPlan;
 use anyhow::{Context, Result};
-use indicatif::{ProgressBar, ProgressStyle};
 use recorder::Simulation;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -38,19 +37,6 @@ struct RunSummary {
     heat_relative_change: f64,
 }
 
-fn progress_bar(total: u64, json: bool) -> ProgressBar {
-    if json {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total);
-    bar.set_style(
-        ProgressStyle::with_template("{msg:>9} [{bar:40}] {pos}/{len} steps ({eta} left)")
-            .expect("static template")
-            .progress_chars("=> "),
-    );
-    bar
-}
-
 pub fn run(plan: &RunPlan) -> Result<()> {
     let summary = crate::with_workers(plan.threads, || simulate(plan))?;
     if plan.json {
@@ -70,7 +56,8 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     );
     let mut sim =
         Simulation::new(case).with_context(|| format!("case {}", plan.case_path.display()))?;
-    let bar = progress_bar(n_settle + n_spin + n_heat, plan.json);
+    let bar = crate::progress::dem_bar(plan.json, "");
+    bar.set_length(n_settle + n_spin + n_heat);
     let every = 200;
     let wall_start = Instant::now();
 
