@@ -9,7 +9,7 @@ use crate::integrate;
 use crate::math::*;
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
-use crate::slices::split_by;
+use crate::slices::for_each_task;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
@@ -89,15 +89,6 @@ impl Pipeline {
     }
 }
 
-/// Runs `work` on every task, in parallel when there is more than one.
-fn for_each_task<T: Send>(tasks: Vec<T>, work: impl Fn(T) -> u64 + Sync + Send) -> u64 {
-    if tasks.len() <= 1 {
-        tasks.into_iter().map(work).sum()
-    } else {
-        tasks.into_par_iter().map(work).sum()
-    }
-}
-
 /// Sphere–sphere forces, torques and conduction, each pair evaluated once from the half list.
 ///
 /// Layer `l` of the cell grid owns the pairs of its particles, whose partners lie in layer
@@ -150,31 +141,21 @@ pub fn pair_interactions(
     let (law, heat) = (&params.particle_particle, &params.conduction);
     let mut pairs = 0;
     for phase in 0..2 {
-        let owned = (phase..layers).step_by(2);
-        // slots a task writes (its layer and the next) and entries it owns (its layer's)
-        let slots = owned.clone().map(|l| {
-            (
-                layer_start[l] as usize,
-                layer_start[(l + 2).min(layers)] as usize,
-            )
-        });
-        let entries = owned.clone().map(|l| {
-            (
-                offsets[layer_start[l] as usize] as usize,
-                offsets[layer_start[l + 1] as usize] as usize,
-            )
-        });
-        let tasks: Vec<_> = owned
-            .zip(split_by(force, slots.clone()))
-            .zip(split_by(torque, slots.clone()))
-            .zip(split_by(heat_flow, slots))
-            .zip(
-                split_by(history, entries.clone())
-                    .into_iter()
-                    .zip(split_by(touching, entries)),
-            )
-            .collect();
-        pairs += for_each_task(tasks, |((((l, f), t), q), (h, touch))| {
+        // task k owns layer l = phase + 2k: it writes the slots of l and l + 1 and the
+        // entries of l (its pieces reach the next task's start; it touches only those)
+        let layer = |k: usize| phase + 2 * k;
+        let start = |k: usize| {
+            let s = layer_start[layer(k)] as usize;
+            let e = offsets[s] as usize;
+            ((s, s), (s, (e, e)))
+        };
+        let arrays = (
+            (&mut force[..], &mut torque[..]),
+            (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
+        );
+        let tasks = 0..layers.saturating_sub(phase).div_ceil(2);
+        let work = |k: usize, ((f, t), (q, (h, touch))): Accumulators| {
+            let l = layer(k);
             let first_slot = layer_start[l] as usize;
             let first_entry = offsets[first_slot] as usize;
             let mut touching_pairs = 0;
@@ -217,10 +198,17 @@ pub fn pair_interactions(
                 q[il] += qi;
             }
             touching_pairs
-        });
+        };
+        pairs += for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work);
     }
     2 * pairs
 }
+
+/// A task's force, torque, heat-flow, history and touching pieces.
+type Accumulators<'a> = (
+    (&'a mut [Vec3], &'a mut [Vec3]),
+    (&'a mut [f64], (&'a mut [ContactHistory], &'a mut [bool])),
+);
 
 /// Sphere–wall forces and heated-wall conduction over the wall candidates of the list,
 /// added to the pair results (each particle writes only its own sums).
@@ -256,24 +244,22 @@ pub fn wall_interactions(
     } = neighbors;
     let wall_offsets = &*wall_offsets;
     let wall_index = &*wall_index;
-    let block_bounds = (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
-    let entry_bounds = block_bounds
-        .clone()
-        .map(|(lo, hi)| (wall_offsets[lo] as usize, wall_offsets[hi] as usize));
-    let tasks: Vec<_> = force
-        .chunks_mut(BLOCK)
-        .zip(torque.chunks_mut(BLOCK))
-        .zip(heat_flow.chunks_mut(BLOCK))
-        .zip(
-            split_by(wall_history, entry_bounds.clone())
-                .into_iter()
-                .zip(split_by(wall_touching, entry_bounds)),
-        )
-        .enumerate()
-        .collect();
     let dt = params.dt;
     let (law, heat) = (&params.particle_wall, &params.conduction);
-    for_each_task(tasks, |(b, (((f, t), q), (h, touch)))| {
+    // task b owns the slots of block b and their wall candidates
+    let start = |b: usize| {
+        let first = b * BLOCK;
+        let w = wall_offsets[first] as usize;
+        ((first, first), (first, (w, w)))
+    };
+    let arrays = (
+        (&mut force[..], &mut torque[..]),
+        (
+            &mut heat_flow[..],
+            (&mut wall_history[..], &mut wall_touching[..]),
+        ),
+    );
+    let work = |b: usize, ((f, t), (q, (h, touch))): Accumulators| {
         let first_slot = b * BLOCK;
         let first_entry = wall_offsets[first_slot] as usize;
         let mut touching = 0;
@@ -307,5 +293,7 @@ pub fn wall_interactions(
             }
         }
         touching
-    })
+    };
+    let tasks = 0..n.div_ceil(BLOCK);
+    for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
 }

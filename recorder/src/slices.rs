@@ -1,30 +1,106 @@
-//! Disjoint mutable pieces of one array, for parallel tasks that each own a consecutive range.
+//! Parallel tasks that each own consecutive ranges of several arrays, handed out by
+//! splitting the arrays in halves (rayon::join) — safe, and without allocating.
 
-/// Splits `items` into consecutive mutable pieces, piece `b` covering `bounds[b].0..bounds[b].1`
-/// (bounds increasing and not overlapping; gaps are skipped).
-pub fn split_by<T>(
-    mut items: &mut [T],
-    bounds: impl Iterator<Item = (usize, usize)>,
-) -> Vec<&mut [T]> {
-    let mut pieces = Vec::new();
-    let mut at = 0;
-    for (lo, hi) in bounds {
-        let (_, rest) = std::mem::take(&mut items).split_at_mut(lo - at);
-        let (piece, rest) = rest.split_at_mut(hi - lo);
-        pieces.push(piece);
-        items = rest;
-        at = hi;
+use std::ops::Range;
+
+/// Mutable arrays that split together: a slice, or a pair of them (nest pairs for more).
+pub trait Pieces: Sized + Send {
+    /// A position in each array.
+    type At: Copy + Send + Sync;
+    /// Splits at `at`, this piece starting at `from`.
+    fn split(self, from: Self::At, at: Self::At) -> (Self, Self);
+}
+
+impl<T: Send> Pieces for &mut [T] {
+    type At = usize;
+    fn split(self, from: usize, at: usize) -> (Self, Self) {
+        self.split_at_mut(at - from)
     }
-    pieces
+}
+
+impl<A: Pieces, B: Pieces> Pieces for (A, B) {
+    type At = (A::At, B::At);
+    fn split(self, from: Self::At, at: Self::At) -> (Self, Self) {
+        let (a0, a1) = self.0.split(from.0, at.0);
+        let (b0, b1) = self.1.split(from.1, at.1);
+        ((a0, b0), (a1, b1))
+    }
+}
+
+/// Runs `work(task, pieces)` for every task of `tasks`, in parallel, and sums the results.
+/// Task `k`'s pieces start at `start(k)` and reach the next task's start (the last task's,
+/// the arrays' end); `start` must not decrease and `origin` is where the arrays begin.
+/// What a task does with its pieces does not depend on how the tasks were shared out.
+pub fn for_each_task<P: Pieces>(
+    arrays: P,
+    origin: P::At,
+    tasks: Range<usize>,
+    start: &(impl Fn(usize) -> P::At + Sync),
+    work: &(impl Fn(usize, P) -> u64 + Sync),
+) -> u64 {
+    if tasks.is_empty() {
+        return 0;
+    }
+    let first = start(tasks.start);
+    let (_, pieces) = arrays.split(origin, first);
+    split_tasks(pieces, first, tasks, start, work)
+}
+
+fn split_tasks<P: Pieces>(
+    pieces: P,
+    from: P::At,
+    tasks: Range<usize>,
+    start: &(impl Fn(usize) -> P::At + Sync),
+    work: &(impl Fn(usize, P) -> u64 + Sync),
+) -> u64 {
+    if tasks.len() == 1 {
+        return work(tasks.start, pieces);
+    }
+    let mid = tasks.start + tasks.len() / 2;
+    let at = start(mid);
+    let (left, right) = pieces.split(from, at);
+    let (a, b) = rayon::join(
+        || split_tasks(left, from, tasks.start..mid, start, work),
+        || split_tasks(right, at, mid..tasks.end, start, work),
+    );
+    a + b
 }
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
-    fn pieces_cover_their_ranges_and_skip_gaps() {
-        let mut v: Vec<u32> = (0..10).collect();
-        let pieces = super::split_by(&mut v, [(1, 3), (3, 3), (5, 9)].into_iter());
-        let got: Vec<Vec<u32>> = pieces.into_iter().map(|p| p.to_vec()).collect();
-        assert_eq!(got, vec![vec![1, 2], vec![], vec![5, 6, 7, 8]]);
+    fn every_task_gets_its_ranges_of_every_array() {
+        let mut a: Vec<u32> = (0..10).collect();
+        let mut b: Vec<u32> = (100..120).collect();
+        // task k owns a[2k + 1 ..] and b[4k ..], up to the next task's start
+        let seen = std::sync::Mutex::new(Vec::new());
+        let total = for_each_task(
+            (&mut a[..], &mut b[..]),
+            (0, 0),
+            0..4,
+            &|k| (2 * k + 1, 4 * k),
+            &|k, (pa, pb): (&mut [u32], &mut [u32])| {
+                seen.lock()
+                    .unwrap()
+                    .push((k, pa[0], pa.len(), pb[0], pb.len()));
+                pa[0] = 0;
+                1
+            },
+        );
+        assert_eq!(total, 4);
+        let mut seen = seen.into_inner().unwrap();
+        seen.sort();
+        assert_eq!(
+            seen,
+            vec![
+                (0, 1, 2, 100, 4),
+                (1, 3, 2, 104, 4),
+                (2, 5, 2, 108, 4),
+                (3, 7, 3, 112, 8)
+            ]
+        );
+        assert_eq!(a, vec![0, 0, 2, 0, 4, 0, 6, 0, 8, 9]);
     }
 }

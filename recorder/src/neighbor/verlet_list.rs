@@ -10,7 +10,7 @@ use crate::contact::contact_sphere_sphere::{effective, overlapping};
 use crate::contact::ContactHistory;
 use crate::math::*;
 use crate::particles::{ParticleSet, PermuteScratch};
-use crate::slices::split_by;
+use crate::slices::for_each_task;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
@@ -190,43 +190,53 @@ impl NeighborList {
             .resize(wall_entries, ContactHistory::default());
         self.wall_touching.resize(wall_entries, false);
 
-        let blocks = || (0..n.div_ceil(BLOCK)).map(|b| (b * BLOCK, ((b + 1) * BLOCK).min(n)));
+        // task b fills the entries and wall candidates of the slots of block b
         let (offsets, wall_offsets) = (&self.offsets, &self.wall_offsets);
-        let entry_bounds = || blocks().map(|(lo, hi)| (offsets[lo] as usize, offsets[hi] as usize));
-        let wall_bounds =
-            || blocks().map(|(lo, hi)| (wall_offsets[lo] as usize, wall_offsets[hi] as usize));
+        let start = |b: usize| {
+            let (e, w) = (
+                offsets[b * BLOCK] as usize,
+                wall_offsets[b * BLOCK] as usize,
+            );
+            (e, (e, (e, (w, (w, w)))))
+        };
         let (ids, carried) = (&particles.id, &self.carried);
-        let tasks: Vec<_> = blocks()
-            .zip(split_by(&mut self.neighbors, entry_bounds()))
-            .zip(split_by(&mut self.history, entry_bounds()))
-            .zip(split_by(&mut self.touching, entry_bounds()))
-            .zip(split_by(&mut self.wall_index, wall_bounds()))
-            .zip(split_by(&mut self.wall_history, wall_bounds()))
-            .zip(split_by(&mut self.wall_touching, wall_bounds()))
-            .collect();
-        tasks.into_par_iter().for_each(
-            |((((((range, partner), history), touch), wall), wall_history), wall_touch)| {
-                let (mut e, mut w) = (0, 0);
-                for i in range.0..range.1 {
-                    search.partners(i, |j, now_touching| {
-                        // a history matters only to a pair touching now (the pair stage's
-                        // own test): it resets the others
-                        let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
-                        partner[e] = j as u32;
-                        history[e] = h.unwrap_or_default();
-                        touch[e] = h.is_some();
-                        e += 1;
-                    });
-                    search.walls(i, |k| {
-                        let h = carried.find(ids[i], n as u32 + k as u32);
-                        wall[w] = k as u8;
-                        wall_history[w] = h.unwrap_or_default();
-                        wall_touch[w] = h.is_some();
-                        w += 1;
-                    });
-                }
-            },
+        let arrays = (
+            &mut self.neighbors[..],
+            (
+                &mut self.history[..],
+                (
+                    &mut self.touching[..],
+                    (
+                        &mut self.wall_index[..],
+                        (&mut self.wall_history[..], &mut self.wall_touching[..]),
+                    ),
+                ),
+            ),
         );
+        let fill = |b: usize, (partner, (history, (touch, (wall, (wall_history, wall_touch))))): ListPieces| {
+            let (mut e, mut w) = (0, 0);
+            for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
+                search.partners(i, |j, now_touching| {
+                    // a history matters only to a pair touching now (the pair stage's
+                    // own test): it resets the others
+                    let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
+                    partner[e] = j as u32;
+                    history[e] = h.unwrap_or_default();
+                    touch[e] = h.is_some();
+                    e += 1;
+                });
+                search.walls(i, |k| {
+                    let h = carried.find(ids[i], n as u32 + k as u32);
+                    wall[w] = k as u8;
+                    wall_history[w] = h.unwrap_or_default();
+                    wall_touch[w] = h.is_some();
+                    w += 1;
+                });
+            }
+            0
+        };
+        let origin = (0, (0, (0, (0, (0, 0)))));
+        for_each_task(arrays, origin, 0..n.div_ceil(BLOCK), &start, &fill);
 
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
@@ -255,6 +265,19 @@ impl NeighborList {
         self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize
     }
 }
+
+/// One list-filling task's pieces: partners, histories, touching flags, and the same for
+/// its wall candidates.
+type ListPieces<'a> = (
+    &'a mut [u32],
+    (
+        &'a mut [ContactHistory],
+        (
+            &'a mut [bool],
+            (&'a mut [u8], (&'a mut [ContactHistory], &'a mut [bool])),
+        ),
+    ),
+);
 
 /// The broad-phase search over particles already in cell order.
 struct Search<'a> {
