@@ -135,6 +135,28 @@ pub fn evaluate(
 }
 
 /// `x` as a percentage with 3 decimals, or "-".
+/// The columns that end the sampling and period tables: an outcome's replay time, errors
+/// and speedup.
+pub(crate) fn outcome_header() -> String {
+    format!(
+        "{:>10} {:>12} {:>10} {:>9}",
+        "replay s/τ", "max eps_rel%", "|eq10| %", "speedup"
+    )
+}
+
+impl Outcome {
+    /// This outcome's cells under [`outcome_header`].
+    pub(crate) fn cells(&self) -> String {
+        format!(
+            "{:>10} {:>12} {:>10} {:>9}",
+            num(self.replay_seconds_per_period, 4),
+            pct(self.eps_rel_max),
+            pct(self.energy_error_mean_abs),
+            num(self.speedup_100, 2),
+        )
+    }
+}
+
 pub(crate) fn pct(x: Option<f64>) -> String {
     x.map_or("-".into(), |v| format!("{:.3}", 100.0 * v))
 }

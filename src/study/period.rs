@@ -2,7 +2,7 @@
 //! The DEM runs once to t0; from a copy of that state each τ is recorded (as `tdex record`
 //! does) with a DEM reference over R revolutions, extrapolated R/τ periods and compared.
 
-use super::{evaluate, num, pct, plots, run_paths, Outcome};
+use super::{evaluate, plots, run_paths, Outcome};
 use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
 use recorder::record::{self, RecordOptions};
@@ -154,30 +154,24 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
 
 fn table(s: &PeriodStudy) -> String {
     let mut t = format!(
-        "{:>8} {:>8} {:>7} {:>9} {:>9} {:>10} {:>12} {:>10} {:>9}\n",
+        "{:>8} {:>8} {:>7} {:>9} {:>9} {}\n",
         "τ (rev)",
         "τ (s)",
         "periods",
         "rows",
         "table MB",
-        "replay s/τ",
-        "max eps_rel%",
-        "|eq10| %",
-        "speedup"
+        super::outcome_header()
     );
     for e in &s.runs {
         let o = &e.outcome;
         t += &format!(
-            "{:>8} {:>8.4} {:>7} {:>9} {:>9.3} {:>10} {:>12} {:>10} {:>9}\n",
+            "{:>8} {:>8.4} {:>7} {:>9} {:>9.3} {}\n",
             e.tau_rev,
             e.tau,
             o.periods,
             o.rows,
             o.table_bytes as f64 / 1e6,
-            num(o.replay_seconds_per_period, 4),
-            pct(o.eps_rel_max),
-            pct(o.energy_error_mean_abs),
-            num(o.speedup_100, 2),
+            o.cells(),
         );
         if let Some(err) = &o.error {
             t += &format!("         τ = {} rev: not extrapolated: {err}\n", e.tau_rev);

@@ -2,7 +2,7 @@
 //! the period, the K-period reference) feeds one sampler per (n, Δt_c^max); each recording
 //! is extrapolated K periods and compared with the shared reference.
 
-use super::{evaluate, num, pct, plots, run_paths, Outcome};
+use super::{evaluate, pct, plots, run_paths, Outcome};
 use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
 use recorder::record::{self, RecordJob, RecordOptions};
@@ -189,30 +189,24 @@ pub fn run(
 
 fn table(s: &SamplingStudy) -> String {
     let mut t = format!(
-        "{:>4} {:>9} {:>9} {:>9} {:>7} {:>10} {:>10} {:>10} {:>9}\n",
+        "{:>4} {:>9} {:>9} {:>9} {:>7} {}\n",
         "n",
         "dtc_max",
         "rows",
         "table MB",
         "B/row",
-        "replay s/τ",
-        "max eps_rel%",
-        "|eq10| %",
-        "speedup"
+        super::outcome_header()
     );
     for e in &s.grid {
         let o = &e.outcome;
         t += &format!(
-            "{:>4} {:>9} {:>9} {:>9.3} {:>7.2} {:>10} {:>12} {:>10} {:>9}\n",
+            "{:>4} {:>9} {:>9} {:>9.3} {:>7.2} {}\n",
             e.n,
             e.dtc_max_steps,
             o.rows,
             o.table_bytes as f64 / 1e6,
             o.bytes_per_row,
-            num(o.replay_seconds_per_period, 4),
-            pct(o.eps_rel_max),
-            pct(o.energy_error_mean_abs),
-            num(o.speedup_100, 2),
+            o.cells(),
         );
         if let Some(err) = &o.error {
             t += &format!(
