@@ -99,8 +99,6 @@ pub struct ContactResponse {
     pub moment_arm_torque: Vec3,
     /// The rolling-resistance torque `M`: `−M` on `i`, `+M` on the partner.
     pub rolling_torque: Vec3,
-    /// Normal force magnitude (positive in compression).
-    pub normal_force: f64,
 }
 
 impl ContactResponse {
@@ -161,6 +159,5 @@ pub fn respond(
         force: add(scale(en, fn_mag), ft),
         moment_arm_torque: cross(en, ft),
         rolling_torque,
-        normal_force: fn_mag,
     }
 }
