@@ -1,7 +1,7 @@
 //! `tdex demo`: the whole method end to end on the built-in small drum — record one
 //! revolution with a six-period DEM reference, extrapolate six periods, compare, report.
 
-use crate::cli::{DemoPlan, ExtrapolatePlan, RecordPlan};
+use crate::cli::{DemoPlan, ExtrapolatePlan, RecordPlan, RecordStart};
 use crate::{compare, extrapolation, record, report};
 use anyhow::{Context, Result};
 use extrapolate::replay::Scheme;
@@ -31,12 +31,16 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         case.drum.rotation_period
     );
     let options = crate::cli::record_options(&case, None, None, 10, 100, PERIODS, false)?;
-    record::run(&RecordPlan {
-        case_path: case_path.clone(),
-        case_toml,
-        case,
-        output: recording.clone(),
-        options,
+    record::run(RecordPlan {
+        start: RecordStart::Fresh {
+            case_path: case_path.clone(),
+            case_toml,
+            case: Box::new(case),
+            output: recording.clone(),
+            options,
+            checkpoint_every: None,
+            reproducible: false,
+        },
         threads: plan.threads,
         json: false,
     })?;

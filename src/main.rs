@@ -35,7 +35,7 @@ fn main() -> ExitCode {
     let args = cli::Cli::parse_args();
     let result = cli::Plan::from_args(args).and_then(|plan| match plan {
         cli::Plan::Run(p) => run::run(&p),
-        cli::Plan::Record(p) => record::run(&p),
+        cli::Plan::Record(p) => record::run(p),
         cli::Plan::Inspect(p) => inspect::run(&p),
         cli::Plan::Bench(p) => bench::engine(&p),
         cli::Plan::BenchRecord(p) => bench::record(&p),
@@ -60,6 +60,10 @@ fn main() -> ExitCode {
                     || e.downcast_ref::<recorder::format::FormatError>()
                         .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::import::ImportError>()
+                        .is_some_and(|f| f.is_bad_input())
+                    || e.downcast_ref::<recorder::record::CheckpointError>()
+                        .is_some_and(|f| f.is_bad_input())
+                    || e.downcast_ref::<recorder::record::RecordError>()
                         .is_some_and(|f| f.is_bad_input())
             };
             if err.chain().any(bad_input) {

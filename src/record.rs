@@ -1,6 +1,6 @@
 //! `tdex record`: the recording stage with a progress bar and a summary of what was written.
 
-use crate::cli::RecordPlan;
+use crate::cli::{RecordPlan, RecordStart};
 use crate::inspect::Sampling;
 use anyhow::{Context, Result};
 use recorder::format::RecordingReader;
@@ -16,6 +16,8 @@ struct RecordReport {
     #[serde(flatten)]
     sampling: Sampling,
     threads: usize,
+    /// false with `--reproducible`: the times below are then 0
+    costs_recorded: bool,
     rows: u64,
     wall_rows: u64,
     file_bytes: u64,
@@ -28,31 +30,72 @@ struct RecordReport {
     stage_seconds: BTreeMap<String, f64>,
 }
 
-pub fn run(plan: &RecordPlan) -> Result<()> {
+pub fn run(plan: RecordPlan) -> Result<()> {
     let bar = crate::progress::dem_bar(plan.json, "");
     let mut progress = crate::progress::on_phase(&bar);
-    crate::with_workers(plan.threads, || {
-        Ok(record::record(
-            &plan.case,
-            &plan.case_path,
-            &plan.case_toml,
-            &plan.options,
-            &plan.output,
-            &mut progress,
-        )?)
-    })
-    .with_context(|| format!("recording case {}", plan.case_path.display()))?;
+    let (output, case_name) = match plan.start {
+        RecordStart::Fresh {
+            case_path,
+            case_toml,
+            case,
+            output,
+            options,
+            checkpoint_every,
+            reproducible,
+        } => {
+            let run = record::RecordRun {
+                case: &case,
+                case_path: &case_path,
+                case_toml: &case_toml,
+                options: &options,
+                dest: &output,
+                checkpoint_every,
+                write_costs: !reproducible,
+            };
+            if checkpoint_every.is_some() {
+                eprintln!(
+                    "checkpoints to {} (resume with: tdex record --resume {0})",
+                    record::checkpoint_path(&output).display()
+                );
+            }
+            crate::with_workers(plan.threads, || {
+                Ok(record::record_run(&run, &mut progress)?)
+            })
+            .with_context(|| format!("recording case {}", case_path.display()))?;
+            (output, case.name)
+        }
+        RecordStart::Resume {
+            path,
+            checkpoint,
+            checkpoint_every,
+        } => {
+            let output = checkpoint.dest.clone();
+            eprintln!("resuming from {}", checkpoint.header);
+            let name = checkpoint.case(&path)?.name;
+            crate::with_workers(plan.threads, || {
+                Ok(record::resume(
+                    *checkpoint,
+                    &path,
+                    checkpoint_every,
+                    &mut progress,
+                )?)
+            })
+            .with_context(|| format!("resuming {}", path.display()))?;
+            (output, name)
+        }
+    };
     bar.finish_and_clear();
 
-    let reader = RecordingReader::open(&plan.output)?;
+    let reader = RecordingReader::open(&output)?;
     let info = reader.info();
     let summary = reader.summary().expect("written by finish");
-    let costs = reader.costs().expect("written by finish");
+    let costs = reader.costs().cloned().unwrap_or_default();
     let report = RecordReport {
-        output: plan.output.display().to_string(),
-        case: plan.case.name.clone(),
+        output: output.display().to_string(),
+        case: case_name,
         sampling: Sampling::of(info),
         threads: costs.threads,
+        costs_recorded: reader.costs().is_some(),
         rows: summary.rows,
         wall_rows: summary.wall_rows,
         file_bytes: reader.file_bytes(),
@@ -82,10 +125,14 @@ pub fn run(plan: &RecordPlan) -> Result<()> {
             report.bytes_per_row,
             report.file_bytes as f64 / 1e6
         );
-        println!(
-            "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
-            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
-        );
+        if report.costs_recorded {
+            println!(
+                "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
+                report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
+            );
+        } else {
+            println!("time          not recorded (--reproducible)");
+        }
     }
     Ok(())
 }

@@ -3,7 +3,7 @@
 use std::time::{Duration, Instant};
 
 /// Time spent in each stage since the counters were created or reset.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Counters {
     /// Displacement check, re-sort and Verlet-list build.
     pub neighbor: Duration,

@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 /// Spheres of the simulation. Index `i` is the memory slot (changes at every re-sort);
 /// `id[i]` is the particle's permanent id.
-#[derive(Debug, Clone, Default, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ParticleSet {
     pub id: Vec<u32>,
     pub pos: Vec<[f64; 3]>,
@@ -55,6 +55,40 @@ impl ParticleSet {
         for field in [&mut self.radius, &mut self.mass, &mut self.temp] {
             permute_field(field, order, &mut scratch.scalars);
         }
+    }
+
+    /// Checks a set read back from a checkpoint: every field holds `n` values and the ids
+    /// are a permutation of `0..n` (the engine indexes by both).
+    pub fn check(&self, n: usize) -> Result<(), String> {
+        let lengths = [
+            ("id", self.id.len()),
+            ("pos", self.pos.len()),
+            ("vel", self.vel.len()),
+            ("omega", self.omega.len()),
+            ("force", self.force.len()),
+            ("torque", self.torque.len()),
+            ("radius", self.radius.len()),
+            ("mass", self.mass.len()),
+            ("temp", self.temp.len()),
+            ("heat_flow", self.heat_flow.len()),
+        ];
+        if let Some((field, len)) = lengths.iter().find(|(_, len)| *len != n) {
+            return Err(format!(
+                "particle field {field} has {len} values, the case has {n} particles"
+            ));
+        }
+        let mut seen = vec![false; n];
+        for (slot, &id) in self.id.iter().enumerate() {
+            match seen.get_mut(id as usize) {
+                Some(s) if !*s => *s = true,
+                _ => {
+                    return Err(format!(
+                        "particle slot {slot} has id {id}: ids must be 0..{n}, each once"
+                    ))
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Slot of every id: `slot_of()[id] = i`.

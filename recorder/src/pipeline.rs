@@ -27,7 +27,7 @@ pub struct StepParams {
 }
 
 /// Contacts counted during the last step.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct ContactCount {
     /// Particle–particle contacts seen from both sides (twice the number of pairs).
     pub pair_entries: u64,

@@ -33,7 +33,7 @@ pub enum SimulationError {
 }
 
 /// Initial-temperature groups: the hot and cold halves of a split, by particle id.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Groups {
     /// `hot[id]`: whether particle `id` started hot; empty for a uniform start.
     pub hot: Vec<bool>,

@@ -31,7 +31,8 @@ pub enum Command {
     /// collision table and the snapshots at t0 and t1 (and K reference periods) into MCAP.
     Record {
         /// The case file (TOML).
-        case: PathBuf,
+        #[arg(required_unless_present = "resume")]
+        case: Option<PathBuf>,
         #[command(flatten)]
         table: TableFlags,
         /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
@@ -43,6 +44,24 @@ pub enum Command {
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
         json: bool,
+        /// Every SECONDS of wall time, save the whole state of the run (atomically) to
+        /// OUTPUT.checkpoint, with the table rows so far in OUTPUT.checkpoint.rows; both are
+        /// removed when the recording is complete.
+        #[arg(long = "checkpoint-every", value_name = "SECONDS")]
+        checkpoint_every: Option<f64>,
+        /// Continue the run a checkpoint was taken in: `tdex record --resume
+        /// OUTPUT.checkpoint`. The recording is the one the run would have written without
+        /// the interruption, byte for byte up to its costs record.
+        #[arg(
+            long,
+            value_name = "CHECKPOINT",
+            conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "reproducible"]
+        )]
+        resume: Option<PathBuf>,
+        /// Leave out the costs record (wall times, thread count): the same case, seed and
+        /// flags then give the same file byte for byte, resumed or not.
+        #[arg(long)]
+        reproducible: bool,
     },
     /// Pair the t0 and t1 snapshots of a recording (minimum total distance, certified
     /// optimal) and store the pairing beside it (RECORDING.pairing.json) for reuse.
@@ -213,8 +232,9 @@ pub enum BenchCommand {
 #[derive(Debug, clap::Args)]
 pub struct TableFlags {
     /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+    /// Required (`tdex record --resume` takes it from the checkpoint).
     #[arg(short = 'o', long = "output")]
-    pub output: PathBuf,
+    pub output: Option<PathBuf>,
     /// Period τ in seconds (default: one drum revolution).
     #[arg(long, conflicts_with = "tau_rev")]
     pub tau: Option<f64>,

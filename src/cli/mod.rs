@@ -7,6 +7,6 @@ pub use args::Cli;
 pub(crate) use plan::record_options;
 pub use plan::{
     BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExportVtkPlan, ExtrapolatePlan, ImportPlan,
-    InspectPlan, PairPlan, Plan, RecordPlan, RegimeRun, ReportPlan, RunPlan, StudyKind, StudyPlan,
-    UsageError,
+    InspectPlan, PairPlan, Plan, RecordPlan, RecordStart, RegimeRun, ReportPlan, RunPlan,
+    StudyKind, StudyPlan, UsageError,
 };

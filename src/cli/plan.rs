@@ -159,13 +159,30 @@ pub struct BenchRecordPlan {
 }
 
 pub struct RecordPlan {
-    pub case_path: PathBuf,
-    pub case_toml: String,
-    pub case: Case,
-    pub output: PathBuf,
-    pub options: RecordOptions,
+    pub start: RecordStart,
     pub threads: usize,
     pub json: bool,
+}
+
+/// A new recording, or the rest of a checkpointed one.
+pub enum RecordStart {
+    Fresh {
+        case_path: PathBuf,
+        case_toml: String,
+        case: Box<Case>,
+        output: PathBuf,
+        options: RecordOptions,
+        /// Wall-clock seconds between checkpoints.
+        checkpoint_every: Option<f64>,
+        reproducible: bool,
+    },
+    Resume {
+        /// The checkpoint file, read and checked.
+        path: PathBuf,
+        checkpoint: Box<recorder::record::Checkpoint<'static>>,
+        /// A new interval between checkpoints, if given.
+        checkpoint_every: Option<f64>,
+    },
 }
 
 pub struct InspectPlan {
@@ -211,16 +228,48 @@ impl Plan {
                 reference,
                 threads: t,
                 json,
+                checkpoint_every,
+                resume,
+                reproducible,
             } => {
                 let threads = threads(t)?;
-                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = table_options(&loaded, &table, reference)?;
+                if let Some(s) = checkpoint_every.filter(|s| !(s.is_finite() && *s > 0.0)) {
+                    return Err(usage(format!(
+                        "--checkpoint-every = {s} is not allowed: give the seconds of wall time between checkpoints, > 0"
+                    )));
+                }
+                let start = match (resume, case) {
+                    (Some(path), _) => {
+                        let checkpoint = recorder::record::Checkpoint::read(&path)?;
+                        // the case text inside must still be a valid case
+                        checkpoint.case(&path)?;
+                        RecordStart::Resume {
+                            path,
+                            checkpoint: Box::new(checkpoint),
+                            checkpoint_every,
+                        }
+                    }
+                    (None, Some(case)) => {
+                        let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
+                        let (options, output) = table_options(&loaded, &table, reference)?;
+                        RecordStart::Fresh {
+                            case_path: case,
+                            case_toml,
+                            case: Box::new(loaded),
+                            output,
+                            options,
+                            checkpoint_every,
+                            reproducible,
+                        }
+                    }
+                    (None, None) => {
+                        return Err(usage(
+                            "give the case file to record, or --resume CHECKPOINT".into(),
+                        ))
+                    }
+                };
                 Ok(Plan::Record(RecordPlan {
-                    case_path: case,
-                    case_toml,
-                    case: loaded,
-                    output: table.output,
-                    options,
+                    start,
                     threads,
                     json,
                 }))
@@ -313,13 +362,13 @@ impl Plan {
                 json,
             }) => {
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = table_options(&loaded, &table, 0)?;
+                let (options, output) = table_options(&loaded, &table, 0)?;
                 Ok(Plan::ImportLiggghts(ImportPlan {
                     dumps: recorder::import::liggghts::Dumps { atoms, contacts },
                     case_path: case,
                     case_toml,
                     case: loaded,
-                    output: table.output,
+                    output,
                     options,
                     json,
                 }))
@@ -405,8 +454,8 @@ fn usage(message: String) -> anyhow::Error {
 }
 
 /// The recording settings of `record` and `import` checked against the case, and their
-/// output file.
-fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<RecordOptions> {
+/// output file (required).
+fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<(RecordOptions, PathBuf)> {
     let options = record_options(
         case,
         t.tau,
@@ -416,8 +465,13 @@ fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<RecordOp
         reference,
         t.exact_area,
     )?;
-    check_output(&t.output)?;
-    Ok(options)
+    let Some(output) = t.output.clone() else {
+        return Err(usage(
+            "-o/--output is required: give the recording to write, such as run.mcap".into(),
+        ));
+    };
+    check_output(&output)?;
+    Ok((options, output))
 }
 
 /// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.

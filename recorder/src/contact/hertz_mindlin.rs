@@ -74,7 +74,7 @@ pub struct ContactKinematics {
 
 /// Tangential and rolling springs carried from step to step; zero while the contact is open.
 /// Seen from the partner the same springs are the negated ones.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ContactHistory {
     pub shear: Vec3,
     pub roll: Vec3,

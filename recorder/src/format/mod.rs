@@ -126,7 +126,7 @@ pub struct RecordingSummary {
 }
 
 /// What the run cost, for the speedup report; the last metadata record.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct RecordingCosts {
     /// Wall-clock seconds: DEM to `t0`, the recorded period (DEM + recorder), the reference.
     pub seconds_to_t0: f64,

@@ -24,7 +24,7 @@ pub const POINT_STRIDE: usize = 68;
 pub const FRAME_ID: &str = "drum";
 
 /// The particles at one instant, in fixed-id order (`id[k] == k`).
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Snapshot {
     /// 0 for `t0`, 1 for `t1`, `k` for `t0 + kτ`.
     pub index: u32,

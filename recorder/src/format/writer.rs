@@ -149,12 +149,18 @@ impl RecordingWriter {
         self.rows_written + self.pending.len() as u64
     }
 
+    /// The hidden file the recording is written to until [`Self::finish`].
+    pub fn partial_path(&self) -> &Path {
+        &self.partial
+    }
+
     /// Writes the last batch, the summary (with the collision-duration histogram) and the
-    /// costs, ends the MCAP file and renames it into place.
+    /// costs (if given: without them the file depends only on the run's inputs), ends the
+    /// MCAP file and renames it into place.
     pub fn finish(
         mut self,
         duration_histogram: Vec<u64>,
-        costs: &RecordingCosts,
+        costs: Option<&RecordingCosts>,
     ) -> Result<RecordingSummary, FormatError> {
         self.write_batch()?;
         let summary = RecordingSummary {
@@ -171,7 +177,9 @@ impl RecordingWriter {
             error,
         };
         write_json_metadata(&mut mcap, SUMMARY_METADATA, &summary).map_err(mcap_err)?;
-        write_json_metadata(&mut mcap, COSTS_METADATA, costs).map_err(mcap_err)?;
+        if let Some(costs) = costs {
+            write_json_metadata(&mut mcap, COSTS_METADATA, costs).map_err(mcap_err)?;
+        }
         close_into_place(mcap, &self.partial, &self.dest)?;
         Ok(summary)
     }

@@ -171,7 +171,7 @@ pub fn import(
         stage_seconds: Default::default(),
         threads: 0,
     };
-    let summary = writer.finish(sampler.duration_histogram().to_vec(), &costs)?;
+    let summary = writer.finish(sampler.duration_histogram().to_vec(), Some(&costs))?;
     Ok(ImportReport {
         summary,
         step_t0,

@@ -17,7 +17,7 @@ use rayon::prelude::*;
 /// Particles per parallel task in the list build.
 const BLOCK: usize = 512;
 
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 pub struct NeighborList {
     /// Entries of slot `i` are `offsets[i]..offsets[i + 1]`.
     pub offsets: Vec<u32>,
@@ -44,11 +44,16 @@ pub struct NeighborList {
     /// `(R*, m*)` of every pair when all spheres have one radius and one mass (the pair
     /// stage then skips two divisions per pair).
     pub uniform_pair: Option<(f64, f64)>,
-    /// Scratch of the cell sort and the re-sort.
+    /// Scratch of the cell sort and the re-sort (not part of a checkpoint).
+    #[serde(skip)]
     cell_of: Vec<u32>,
+    #[serde(skip)]
     cell_start: Vec<u32>,
+    #[serde(skip)]
     order: Vec<u32>,
+    #[serde(skip)]
     permute_scratch: PermuteScratch,
+    #[serde(skip)]
     carried: Carried,
 }
 
@@ -251,6 +256,96 @@ impl NeighborList {
             _ => None,
         };
         self.rebuilds += 1;
+    }
+
+    /// Checks a list read back from a checkpoint against `n` particles, the grid's `layers`
+    /// and `walls` walls: every index the stages follow stays in range, and every partner
+    /// lies after its owner in the owner's layer or the next (what the parallel pair stage
+    /// relies on).
+    pub fn check(&self, n: usize, layers: usize, walls: usize) -> Result<(), String> {
+        if self.offsets.is_empty() && self.wall_offsets.is_empty() && self.layer_start.is_empty() {
+            return if self.neighbors.is_empty() && self.pos_at_build.is_empty() {
+                Ok(()) // never built: the first step builds it
+            } else {
+                Err("neighbour list has entries but no offsets".into())
+            };
+        }
+        let csr = |name: &str, offsets: &[u32], entries: usize| -> Result<(), String> {
+            if offsets.len() != n + 1 || offsets[0] != 0 || offsets[n] as usize != entries {
+                return Err(format!(
+                    "{name} offsets: {} values from {:?} to {:?} for {n} particles and {entries} entries",
+                    offsets.len(),
+                    offsets.first(),
+                    offsets.last()
+                ));
+            }
+            match offsets.windows(2).position(|w| w[0] > w[1]) {
+                Some(i) => Err(format!("{name} offsets decrease at slot {i}")),
+                None => Ok(()),
+            }
+        };
+        let entries = self.neighbors.len();
+        csr("pair", &self.offsets, entries)?;
+        csr("wall", &self.wall_offsets, self.wall_index.len())?;
+        if self.history.len() != entries || self.touching.len() != entries {
+            return Err(format!(
+                "{entries} pair entries but {} histories and {} touching flags",
+                self.history.len(),
+                self.touching.len()
+            ));
+        }
+        let wall_entries = self.wall_index.len();
+        if self.wall_history.len() != wall_entries || self.wall_touching.len() != wall_entries {
+            return Err(format!(
+                "{wall_entries} wall candidates but {} histories and {} touching flags",
+                self.wall_history.len(),
+                self.wall_touching.len()
+            ));
+        }
+        if let Some(e) = self.wall_index.iter().position(|&w| w as usize >= walls) {
+            return Err(format!(
+                "wall candidate {e} names wall {} of {walls}",
+                self.wall_index[e]
+            ));
+        }
+        let starts = &self.layer_start;
+        if starts.len() != layers + 1
+            || starts[0] != 0
+            || starts[layers] as usize != n
+            || starts.windows(2).any(|w| w[0] > w[1])
+        {
+            return Err(format!(
+                "layer starts {:?}..{:?} ({} values) do not split {n} particles into {layers} layers",
+                starts.first(),
+                starts.last(),
+                starts.len()
+            ));
+        }
+        for l in 0..layers {
+            let end = starts[(l + 2).min(layers)] as usize;
+            for i in starts[l] as usize..starts[l + 1] as usize {
+                if let Some(e) = self.range(i).find(|&e| {
+                    let j = self.neighbors[e] as usize;
+                    j <= i || j >= end
+                }) {
+                    return Err(format!(
+                        "slot {i} (layer {l}) lists partner {} outside slots {}..{end}",
+                        self.neighbors[e],
+                        i + 1
+                    ));
+                }
+            }
+        }
+        if self.pos_at_build.len() != n {
+            return Err(format!(
+                "{} build positions for {n} particles",
+                self.pos_at_build.len()
+            ));
+        }
+        if !(self.skin.is_finite() && self.skin > 0.0) {
+            return Err(format!("skin = {} (must be > 0)", self.skin));
+        }
+        Ok(())
     }
 
     /// Entry range of slot `i`.

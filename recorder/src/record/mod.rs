@@ -1,18 +1,22 @@
 //! The sampled collision table (Haydar §2.1.1): a sampler fed every `n` DEM steps and the
 //! splitter that cuts collisions longer than `Δt_c^max` into rows (Algorithm 2).
 
+pub mod checkpoint;
+pub mod journal;
 pub mod recording;
 pub mod sampler;
 pub mod splitter;
 
+pub use checkpoint::{Checkpoint, CheckpointError, Stage};
+pub use journal::JournalError;
 pub use recording::{
-    record, record_from_t0, record_many_from_t0, run_to_t0, Phase, RecordError, RecordJob,
-    RecordOptions,
+    checkpoint_path, journal_path, record, record_from_t0, record_many_from_t0, record_run, resume,
+    run_to_t0, Phase, RecordError, RecordJob, RecordOptions, RecordRun,
 };
 pub use sampler::ContactSampler;
 
 /// One row of the collision table, times in DEM steps from the recording's origin.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CollisionRow {
     /// Smaller particle id of the pair (fixed ids).
     pub i: u32,

@@ -1,8 +1,11 @@
 //! `tdex record` as a library call: run the case to `t0`, assign the temperatures, record one
 //! period `τ` (sampled table + snapshots at `t0` and `t1`) and, optionally, K reference periods.
 
-use super::ContactSampler;
+use super::checkpoint::{Checkpoint, CheckpointError, Elapsed, EngineState, OutputState, Stage};
+use super::journal::{JournalError, JournalMark, RowJournal};
+use super::{CollisionRow, ContactSampler};
 use crate::case::Case;
+use crate::format::Snapshot;
 use crate::format::{
     AreaEncoding, FormatError, RecordingCosts, RecordingInfo, RecordingSummary, RecordingWriter,
     WallInfo, FORMAT_VERSION, SQRT_AREA_CODES,
@@ -10,12 +13,13 @@ use crate::format::{
 use crate::heat::ConductionLaw;
 use crate::wall::WallSet;
 use crate::{Simulation, SimulationError};
-use std::path::Path;
+use std::borrow::Cow;
+use std::path::{Path, PathBuf};
 use std::sync::mpsc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// What to record, validated by the caller (the CLI plan).
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RecordOptions {
     /// Sampling factor `n` (steps).
     pub sample_every: u32,
@@ -45,10 +49,64 @@ pub enum RecordError {
     Format(#[from] FormatError),
     #[error("invalid recording settings: {0}")]
     Settings(String),
+    #[error(transparent)]
+    Checkpoint(#[from] CheckpointError),
+    #[error(transparent)]
+    Journal(#[from] JournalError),
 }
 
-/// Steps between progress reports and stability checks outside the recorded period.
+impl RecordError {
+    /// Whether the error is in a file the user gave (exit code 2): a checkpoint or its row
+    /// journal that cannot be resumed.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            RecordError::Checkpoint(e) => e.is_bad_input(),
+            RecordError::Journal(e) => {
+                matches!(
+                    e,
+                    JournalError::Short { .. } | JournalError::Mismatch { .. }
+                )
+            }
+            RecordError::Format(e) => e.is_bad_input(),
+            _ => false,
+        }
+    }
+}
+
+/// Steps between progress reports, stability checks and checkpoint opportunities outside
+/// the recorded period.
 const REPORT_EVERY: u64 = 500;
+
+/// A `tdex record` run: what to record, where, and how often to checkpoint it.
+#[derive(Debug, Clone, Copy)]
+pub struct RecordRun<'a> {
+    pub case: &'a Case,
+    /// The case path as the recording's metadata states it.
+    pub case_path: &'a Path,
+    /// The case file as given (the recording stores it).
+    pub case_toml: &'a str,
+    pub options: &'a RecordOptions,
+    pub dest: &'a Path,
+    /// Wall-clock seconds between checkpoints to [`checkpoint_path`]; `None`: no checkpoints.
+    pub checkpoint_every: Option<f64>,
+    /// Write the `tdex.costs` record (wall times, threads); without it the file depends only
+    /// on the case, its seed and the options, resumed or not.
+    pub write_costs: bool,
+}
+
+/// Where the checkpoints of a recording to `dest` go: `<dest>.checkpoint`.
+pub fn checkpoint_path(dest: &Path) -> PathBuf {
+    let mut name = dest.as_os_str().to_owned();
+    name.push(".checkpoint");
+    PathBuf::from(name)
+}
+
+/// The row journal kept beside a checkpoint: `<checkpoint>.rows`.
+pub fn journal_path(checkpoint: &Path) -> PathBuf {
+    let mut name = checkpoint.as_os_str().to_owned();
+    name.push(".rows");
+    PathBuf::from(name)
+}
 
 /// Runs the case and writes the recording to `dest`. `case_toml` is the case file as given.
 pub fn record(
@@ -59,19 +117,61 @@ pub fn record(
     dest: &Path,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<RecordingSummary, RecordError> {
-    check(opts)?;
-    let started = Instant::now();
-    let mut sim = run_to_t0(case, progress)?;
-    let seconds_to_t0 = started.elapsed().as_secs_f64();
-    record_from_t0(
-        &mut sim,
+    let run = RecordRun {
+        case,
         case_path,
         case_toml,
-        opts,
+        options: opts,
         dest,
-        seconds_to_t0,
-        progress,
-    )
+        checkpoint_every: None,
+        write_costs: true,
+    };
+    record_run(&run, progress)
+}
+
+/// Runs the case and writes the recording, checkpointing every `run.checkpoint_every`
+/// seconds of wall time to [`checkpoint_path`]`(dest)`; the checkpoint and its row journal
+/// are removed once the recording is in place.
+pub fn record_run(
+    run: &RecordRun,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let saver = match run.checkpoint_every {
+        Some(every) => Some(Saver::new(run, &checkpoint_path(run.dest), every)?),
+        None => None,
+    };
+    drive(run, saver, None, progress)
+}
+
+/// Resumes the run in which `checkpoint` (read from `path` by [`Checkpoint::read`]) was
+/// taken, writing further checkpoints to `path` every `every` seconds (default: as before).
+/// The recording is the one the run would have written uninterrupted, to the byte, up to
+/// the costs record (which adds the wall times of both runs).
+pub fn resume(
+    checkpoint: Checkpoint<'static>,
+    path: &Path,
+    every: Option<f64>,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let case = checkpoint.case(path)?;
+    let (case_toml, case_path) = (
+        checkpoint.case_toml.clone().into_owned(),
+        checkpoint.case_path.clone(),
+    );
+    let (options, dest) = (checkpoint.options.clone(), checkpoint.dest.clone());
+    let run = RecordRun {
+        case: &case,
+        case_path: &case_path,
+        case_toml: &case_toml,
+        options: &options,
+        dest: &dest,
+        checkpoint_every: Some(every.unwrap_or(checkpoint.every_seconds)),
+        write_costs: checkpoint.write_costs,
+    };
+    check(&options)?;
+    let restored = checkpoint.restore(&case, path)?;
+    let saver = Saver::new(&run, path, run.checkpoint_every.expect("set above"))?;
+    drive(&run, Some(saver), Some(restored), progress)
 }
 
 fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
@@ -109,6 +209,401 @@ pub fn run_to_t0(
     })?;
     sim.assign_temperatures();
     Ok(sim)
+}
+
+/// Writes the checkpoints of one run.
+struct Saver {
+    path: PathBuf,
+    journal: PathBuf,
+    every: Duration,
+    every_seconds: f64,
+    last: Instant,
+    /// The recording, absolute: a resume may start in another directory.
+    dest: PathBuf,
+}
+
+impl Saver {
+    fn new(run: &RecordRun, path: &Path, every_seconds: f64) -> Result<Self, RecordError> {
+        let every = Duration::try_from_secs_f64(every_seconds)
+            .ok()
+            .filter(|_| every_seconds > 0.0)
+            .ok_or_else(|| {
+                RecordError::Settings(format!(
+                    "checkpoint interval {every_seconds} s: give a number of seconds > 0"
+                ))
+            })?;
+        let absolute = |p: &Path| {
+            std::path::absolute(p).map_err(|error| CheckpointError::Write {
+                path: p.to_path_buf(),
+                error,
+            })
+        };
+        Ok(Self {
+            path: absolute(path)?,
+            journal: absolute(&journal_path(path))?,
+            every,
+            every_seconds,
+            last: Instant::now(),
+            dest: absolute(run.dest)?,
+        })
+    }
+
+    fn due(&self) -> bool {
+        self.last.elapsed() >= self.every
+    }
+
+    fn save(
+        &mut self,
+        run: &RecordRun,
+        sim: &Simulation,
+        stage: Stage,
+        elapsed: Elapsed,
+        output: Option<OutputState>,
+    ) -> Result<(), RecordError> {
+        let checkpoint = Checkpoint {
+            tool_version: env!("CARGO_PKG_VERSION").into(),
+            case_toml: Cow::Borrowed(run.case_toml),
+            case_path: run.case_path.to_path_buf(),
+            options: run.options.clone(),
+            dest: self.dest.clone(),
+            every_seconds: self.every_seconds,
+            write_costs: run.write_costs,
+            stage,
+            elapsed,
+            engine: EngineState::of(sim),
+            output,
+            header: String::new(),
+        };
+        let header = format!(
+            "case {}, {}, t = {:.6} s; continue with: tdex record --resume {}",
+            run.case.name,
+            describe(stage, run),
+            sim.time,
+            self.path.display()
+        );
+        checkpoint.write(&self.path, &header)?;
+        self.last = Instant::now();
+        Ok(())
+    }
+
+    /// The run is complete: its checkpoint and journal are no longer needed.
+    fn remove(self) {
+        let _ = std::fs::remove_file(&self.path);
+        let _ = std::fs::remove_file(&self.journal);
+    }
+}
+
+/// Where a run stands, in words (the checkpoint's first line).
+fn describe(stage: Stage, run: &RecordRun) -> String {
+    let c = run.case;
+    let o = run.options;
+    match stage {
+        Stage::Settle { done } => format!("settle step {done} of {}", c.steps_in(c.time.settle)),
+        Stage::SpinUp { done } => format!("spin-up step {done} of {}", c.steps_in(c.time.spin_up)),
+        Stage::Period { done } => format!("period step {done} of {}", o.period_steps),
+        Stage::Reference { period, done } => format!(
+            "reference period {} of {} step {done} of {}",
+            period + 1,
+            o.reference_periods,
+            o.period_steps
+        ),
+    }
+}
+
+/// Runs `total - done` more steps of a phase in blocks of [`REPORT_EVERY`] (counted from
+/// the phase's start), checking stability and reporting after each block and offering a
+/// checkpoint between blocks.
+fn run_phase(
+    sim: &mut Simulation,
+    mut done: u64,
+    total: u64,
+    progress: &mut dyn FnMut(u64),
+    checkpoint: &mut dyn FnMut(&Simulation, u64) -> Result<(), RecordError>,
+) -> Result<(), RecordError> {
+    while done < total {
+        let block = (REPORT_EVERY - done % REPORT_EVERY).min(total - done);
+        for _ in 0..block {
+            sim.step();
+        }
+        done += block;
+        sim.check_inside()?;
+        progress(done);
+        if done < total {
+            checkpoint(sim, done)?;
+        }
+    }
+    Ok(())
+}
+
+/// The state a run resumes from.
+type Restored = (Simulation, Stage, Elapsed, Option<OutputState<'static>>);
+
+/// The whole run from wherever it stands: settle, spin-up, the recorded period, the
+/// reference periods, with checkpoints when `saver` is given.
+fn drive(
+    run: &RecordRun,
+    mut saver: Option<Saver>,
+    restored: Option<Restored>,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let fresh_sampler = check(run.options)?;
+    let (case, opts) = (run.case, run.options);
+    let (mut sim, mut stage, mut elapsed, output) = match restored {
+        Some(r) => r,
+        None => (
+            Simulation::new(case)?,
+            Stage::Settle { done: 0 },
+            Elapsed::default(),
+            None,
+        ),
+    };
+
+    // to t0
+    let (n_settle, n_spin) = (
+        case.steps_in(case.time.settle),
+        case.steps_in(case.time.spin_up),
+    );
+    let (began, base) = (Instant::now(), elapsed.to_t0);
+    let to_t0 = |elapsed: &Elapsed| Elapsed {
+        to_t0: base + began.elapsed().as_secs_f64(),
+        ..*elapsed
+    };
+    let mut offer = |sim: &Simulation, stage: Stage, elapsed: Elapsed| match &mut saver {
+        Some(s) if s.due() => s.save(run, sim, stage, elapsed, None),
+        _ => Ok(()),
+    };
+    if let Stage::Settle { done } = stage {
+        run_phase(
+            &mut sim,
+            done,
+            n_settle,
+            &mut |d| progress(Phase::Settle, d, n_settle),
+            &mut |sim, done| offer(sim, Stage::Settle { done }, to_t0(&elapsed)),
+        )?;
+        sim.start_rotation();
+        stage = Stage::SpinUp { done: 0 };
+    }
+    if let Stage::SpinUp { done } = stage {
+        run_phase(
+            &mut sim,
+            done,
+            n_spin,
+            &mut |d| progress(Phase::SpinUp, d, n_spin),
+            &mut |sim, done| offer(sim, Stage::SpinUp { done }, to_t0(&elapsed)),
+        )?;
+        sim.assign_temperatures();
+        stage = Stage::Period { done: 0 };
+        elapsed = to_t0(&elapsed);
+    }
+
+    // the output: opened at t0, or rebuilt to where the checkpoint left it
+    let journal = saver.as_ref().map(|s| s.journal.clone());
+    let (mut sink, sampler, mut snapshots, run_at_t0) = match output {
+        None => {
+            let run_at_t0 = RunAtT0::of(&sim);
+            let info = recording_info(case, run.case_path, run.case_toml, opts, run_at_t0.clone());
+            let mut writer = RecordingWriter::create(run.dest, info)?;
+            let t0 = sim.snapshot(0);
+            writer.write_snapshot(&t0)?;
+            let journal = match &journal {
+                Some(path) => Some(RowJournal::create(path)?),
+                None => None,
+            };
+            (
+                RowSink { writer, journal },
+                fresh_sampler,
+                vec![t0],
+                run_at_t0,
+            )
+        }
+        Some(out) => {
+            // the killed run's output is incomplete and hidden; this run writes its own
+            let _ = std::fs::remove_file(&out.partial);
+            let info = recording_info(case, run.case_path, run.case_toml, opts, out.run.clone());
+            let mut writer = RecordingWriter::create(run.dest, info)?;
+            writer.write_snapshot(&out.snapshots[0])?;
+            let path = journal.as_ref().expect("a resumed run keeps checkpointing");
+            let journal = RowJournal::resume(path, out.journal, &mut |rows| {
+                Ok(writer.push_rows(rows.iter().copied())?)
+            })?;
+            for snapshot in &out.snapshots[1..] {
+                writer.write_snapshot(snapshot)?;
+            }
+            let sink = RowSink {
+                writer,
+                journal: Some(journal),
+            };
+            (
+                sink,
+                out.sampler.into_owned(),
+                out.snapshots.into_owned(),
+                out.run,
+            )
+        }
+    };
+
+    // the recorded period
+    let mut sampler = sampler;
+    if let Stage::Period { done } = stage {
+        let began = Instant::now();
+        let (period_base, recorder_base) = (elapsed.period, elapsed.recorder);
+        let partial = sink.writer.partial_path().to_path_buf();
+        let mut hook = PeriodSaver {
+            run,
+            saver: saver.as_mut(),
+            run_at_t0: &run_at_t0,
+            t0: &snapshots[0],
+            partial: &partial,
+            elapsed,
+            began,
+        };
+        let checkpoints: Option<&mut dyn PeriodCheckpoint> = match hook.saver {
+            Some(_) => Some(&mut hook),
+            None => None,
+        };
+        let (mut samplers, busy) = record_period(
+            &mut sim,
+            vec![sampler],
+            std::slice::from_mut(&mut sink),
+            &[opts.sample_every as u64],
+            opts.period_steps,
+            done,
+            checkpoints,
+            progress,
+        )?;
+        sampler = samplers.pop().expect("one sampler");
+        let t = Instant::now();
+        let t1 = sim.snapshot(1);
+        sink.writer.write_snapshot(&t1)?;
+        snapshots.push(t1);
+        elapsed.recorder = recorder_base + busy[0] + t.elapsed().as_secs_f64();
+        elapsed.period = period_base + began.elapsed().as_secs_f64();
+        stage = Stage::Reference { period: 0, done: 0 };
+    }
+
+    // the reference periods
+    if let Stage::Reference {
+        period: first,
+        done,
+    } = stage
+    {
+        let mark = match &mut sink.journal {
+            Some(j) => Some(j.sync()?),
+            None => None,
+        };
+        let (began, base) = (Instant::now(), elapsed.reference);
+        let reference_steps = opts.reference_periods as u64 * opts.period_steps;
+        for period in first..opts.reference_periods {
+            let start = if period == first { done } else { 0 };
+            let offset = period as u64 * opts.period_steps;
+            let partial = sink.writer.partial_path().to_path_buf();
+            run_phase(
+                &mut sim,
+                start,
+                opts.period_steps,
+                &mut |d| progress(Phase::Reference, offset + d, reference_steps),
+                &mut |sim, done| match (&mut saver, mark) {
+                    (Some(s), Some(journal)) if s.due() => {
+                        let output = OutputState {
+                            run: run_at_t0.clone(),
+                            snapshots: Cow::Borrowed(&snapshots),
+                            sampler: Cow::Borrowed(&sampler),
+                            journal,
+                            partial: partial.clone(),
+                        };
+                        let elapsed = Elapsed {
+                            reference: base + began.elapsed().as_secs_f64(),
+                            ..elapsed
+                        };
+                        s.save(
+                            run,
+                            sim,
+                            Stage::Reference { period, done },
+                            elapsed,
+                            Some(output),
+                        )
+                    }
+                    _ => Ok(()),
+                },
+            )?;
+            let snapshot = sim.snapshot(period + 2);
+            sink.writer.write_snapshot(&snapshot)?;
+            snapshots.push(snapshot);
+        }
+        elapsed.reference = base + began.elapsed().as_secs_f64();
+    }
+
+    let costs = run.write_costs.then(|| RecordingCosts {
+        seconds_to_t0: elapsed.to_t0,
+        seconds_period: elapsed.period,
+        seconds_reference: elapsed.reference,
+        seconds_recorder: elapsed.recorder,
+        stage_seconds: stage_seconds(&sim),
+        threads: rayon::current_num_threads(),
+    });
+    let RowSink { writer, journal } = sink;
+    drop(journal);
+    let summary = writer.finish(sampler.duration_histogram().to_vec(), costs.as_ref())?;
+    if let Some(s) = saver {
+        s.remove();
+    }
+    Ok(summary)
+}
+
+fn stage_seconds(sim: &Simulation) -> std::collections::BTreeMap<String, f64> {
+    sim.counters
+        .stages()
+        .iter()
+        .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
+        .collect()
+}
+
+/// The checkpoints of the recorded period: the engine from the DEM thread, the samplers and
+/// journal marks from the recorder thread, the rest from the run.
+struct PeriodSaver<'a> {
+    run: &'a RecordRun<'a>,
+    saver: Option<&'a mut Saver>,
+    run_at_t0: &'a RunAtT0,
+    t0: &'a Snapshot,
+    partial: &'a Path,
+    /// Elapsed times when the period (re)started.
+    elapsed: Elapsed,
+    began: Instant,
+}
+
+impl PeriodCheckpoint for PeriodSaver<'_> {
+    fn due(&self) -> bool {
+        self.saver.as_ref().is_some_and(|s| s.due())
+    }
+
+    fn save(
+        &mut self,
+        sim: &Simulation,
+        done: u64,
+        recorder: RecorderState,
+    ) -> Result<(), RecordError> {
+        let Some(saver) = self.saver.as_deref_mut() else {
+            return Ok(());
+        };
+        let (Some(sampler), Some(Some(journal))) =
+            (recorder.samplers.first(), recorder.journals.first())
+        else {
+            return Ok(()); // only a single journaled recording is checkpointed
+        };
+        let output = OutputState {
+            run: self.run_at_t0.clone(),
+            snapshots: Cow::Borrowed(std::slice::from_ref(self.t0)),
+            sampler: Cow::Borrowed(sampler),
+            journal: *journal,
+            partial: self.partial.to_path_buf(),
+        };
+        let elapsed = Elapsed {
+            period: self.elapsed.period + self.began.elapsed().as_secs_f64(),
+            recorder: self.elapsed.recorder + recorder.busy[0],
+            ..self.elapsed
+        };
+        saver.save(self.run, sim, Stage::Period { done }, elapsed, Some(output))
+    }
 }
 
 /// Records the period `[t0, t1]` of a simulation standing at `t0` (and the reference
@@ -170,30 +665,39 @@ pub fn record_many_from_t0(
         .map(|j| check(&j.options))
         .collect::<Result<Vec<_>, _>>()?;
     let t0 = sim.snapshot(0);
-    let mut writers = Vec::with_capacity(jobs.len());
+    let mut sinks = Vec::with_capacity(jobs.len());
     for j in jobs {
-        let particles = sim.particles.len() as u32;
-        let run = RunAtT0 {
-            particles,
-            r_max: sim.particles.radius.iter().cloned().fold(0.0, f64::max),
-            walls: wall_infos(&sim.walls, particles),
-            t0: sim.time,
-            step_t0: sim.step,
-        };
-        let info = recording_info(&sim.case, case_path, case_toml, &j.options, run);
+        let info = recording_info(
+            &sim.case,
+            case_path,
+            case_toml,
+            &j.options,
+            RunAtT0::of(sim),
+        );
         let mut writer = RecordingWriter::create(j.dest, info)?;
         writer.write_snapshot(&t0)?;
-        writers.push(writer);
+        sinks.push(RowSink {
+            writer,
+            journal: None,
+        });
     }
 
     let period_start = Instant::now();
     let every: Vec<u64> = jobs.iter().map(|j| j.options.sample_every as u64).collect();
-    let (samplers, mut recorder_seconds) =
-        record_period(sim, samplers, &mut writers, &every, period_steps, progress)?;
+    let (samplers, mut recorder_seconds) = record_period(
+        sim,
+        samplers,
+        &mut sinks,
+        &every,
+        period_steps,
+        0,
+        None,
+        progress,
+    )?;
     let t1 = sim.snapshot(1);
-    for (writer, busy) in writers.iter_mut().zip(&mut recorder_seconds) {
+    for (sink, busy) in sinks.iter_mut().zip(&mut recorder_seconds) {
         let t = Instant::now();
-        writer.write_snapshot(&t1)?;
+        sink.writer.write_snapshot(&t1)?;
         *busy += t.elapsed().as_secs_f64();
     }
     let seconds_period = period_start.elapsed().as_secs_f64();
@@ -206,22 +710,17 @@ pub fn record_many_from_t0(
             progress(Phase::Reference, done + s, reference_steps)
         })?;
         let snapshot = sim.snapshot(period + 2);
-        for writer in &mut writers {
-            writer.write_snapshot(&snapshot)?;
+        for sink in &mut sinks {
+            sink.writer.write_snapshot(&snapshot)?;
         }
     }
     let seconds_reference = reference_start.elapsed().as_secs_f64();
-    let stage_seconds: std::collections::BTreeMap<String, f64> = sim
-        .counters
-        .stages()
-        .iter()
-        .map(|(name, d)| (name.to_string(), d.as_secs_f64()))
-        .collect();
-    writers
+    let stage_seconds = stage_seconds(sim);
+    sinks
         .into_iter()
         .zip(samplers)
         .zip(recorder_seconds)
-        .map(|((writer, sampler), seconds_recorder)| {
+        .map(|((sink, sampler), seconds_recorder)| {
             let costs = RecordingCosts {
                 seconds_to_t0,
                 seconds_period,
@@ -230,9 +729,46 @@ pub fn record_many_from_t0(
                 stage_seconds: stage_seconds.clone(),
                 threads: rayon::current_num_threads(),
             };
-            Ok(writer.finish(sampler.duration_histogram().to_vec(), &costs)?)
+            Ok(sink
+                .writer
+                .finish(sampler.duration_histogram().to_vec(), Some(&costs))?)
         })
         .collect()
+}
+
+/// A recording's writer and, when the run is checkpointed, its row journal.
+struct RowSink {
+    writer: RecordingWriter,
+    journal: Option<RowJournal>,
+}
+
+impl RowSink {
+    fn push(&mut self, rows: Vec<CollisionRow>) -> Result<(), RecordError> {
+        if let Some(journal) = &mut self.journal {
+            journal.append(&rows)?;
+        }
+        Ok(self.writer.push_rows(rows)?)
+    }
+}
+
+/// What the recorder thread hands over for a checkpoint: its samplers, the journal marks
+/// (`None` for a recording without journal) and each job's busy seconds so far.
+pub(crate) struct RecorderState {
+    samplers: Vec<ContactSampler>,
+    journals: Vec<Option<JournalMark>>,
+    busy: Vec<f64>,
+}
+
+/// How the period loop offers checkpoints: asked between steps whether one is due, then
+/// given the engine and the recorder's state, consistent at step `done`.
+pub(crate) trait PeriodCheckpoint {
+    fn due(&self) -> bool;
+    fn save(
+        &mut self,
+        sim: &Simulation,
+        done: u64,
+        recorder: RecorderState,
+    ) -> Result<(), RecordError>;
 }
 
 /// Contact lists in flight between the DEM and the recorder thread.
@@ -246,35 +782,63 @@ fn gcd(a: u64, b: u64) -> u64 {
     }
 }
 
-/// The period `[t0, t1]`: the DEM steps on the calling thread (and its pool) while a recorder
-/// thread samples, splits, encodes and writes for every job (sampler `i` takes the steps
-/// that are multiples of `every[i]`). Each sample is the contact list copied at its step, so
-/// the tables are the same as a serial recorder's, whatever the timing; the recorder fills
-/// the cores the DEM leaves idle instead of stalling it. Returns the finished samplers (for
-/// their histograms) and each job's busy seconds on the recorder thread.
+type Sample = Vec<(u32, u32, f64)>;
+
+/// What the DEM thread sends the recorder thread.
+enum ToRecorder {
+    /// The contact list at step `k` of the period.
+    Sample(u64, Sample),
+    /// Everything sent before has been recorded: reply with the state for a checkpoint.
+    Checkpoint(mpsc::Sender<RecorderState>),
+}
+
+/// The period `[t0, t1]` from step `start` on: the DEM steps on the calling thread (and its
+/// pool) while a recorder thread samples, splits, encodes and writes for every job (sampler
+/// `i` takes the steps that are multiples of `every[i]`). Each sample is the contact list
+/// copied at its step, so the tables are the same as a serial recorder's, whatever the
+/// timing; the recorder fills the cores the DEM leaves idle instead of stalling it. Between
+/// steps, `checkpoints` is offered the state when one is due. Returns the finished samplers
+/// (for their histograms) and each job's busy seconds on the recorder thread.
+#[allow(clippy::too_many_arguments)]
 fn record_period(
     sim: &mut Simulation,
     mut samplers: Vec<ContactSampler>,
-    writers: &mut [RecordingWriter],
+    sinks: &mut [RowSink],
     every: &[u64],
     period_steps: u64,
+    start: u64,
+    mut checkpoints: Option<&mut dyn PeriodCheckpoint>,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<(Vec<ContactSampler>, Vec<f64>), RecordError> {
-    type Sample = Vec<(u32, u32, f64)>;
     // every sampled step is a multiple of the stride; the DEM steps that far between checks
     let stride = every.iter().copied().fold(0, gcd);
-    let (to_recorder, samples) = mpsc::sync_channel::<(u64, Sample)>(SAMPLES_IN_FLIGHT);
+    let (to_recorder, messages) = mpsc::sync_channel::<ToRecorder>(SAMPLES_IN_FLIGHT);
     let (to_dem, spare) = mpsc::channel::<Sample>();
     std::thread::scope(|scope| {
         let recorder = scope.spawn(
-            move || -> Result<(Vec<ContactSampler>, Vec<f64>), FormatError> {
+            move || -> Result<(Vec<ContactSampler>, Vec<f64>), RecordError> {
                 let mut busy = vec![0.0; samplers.len()];
-                for (step, contacts) in samples {
+                for message in messages {
+                    let (step, contacts) = match message {
+                        ToRecorder::Sample(step, contacts) => (step, contacts),
+                        ToRecorder::Checkpoint(reply) => {
+                            let journals = sinks
+                                .iter_mut()
+                                .map(|s| s.journal.as_mut().map(|j| j.sync()).transpose())
+                                .collect::<Result<Vec<_>, _>>()?;
+                            let _ = reply.send(RecorderState {
+                                samplers: samplers.clone(),
+                                journals,
+                                busy: busy.clone(),
+                            });
+                            continue;
+                        }
+                    };
                     for (i, sampler) in samplers.iter_mut().enumerate() {
                         if step % every[i] == 0 {
                             let t = Instant::now();
                             sampler.sample(step, contacts.iter().copied());
-                            writers[i].push_rows(sampler.drain_ready())?;
+                            sinks[i].push(sampler.drain_ready())?;
                             busy[i] += t.elapsed().as_secs_f64();
                         }
                     }
@@ -282,14 +846,14 @@ fn record_period(
                 }
                 for (i, sampler) in samplers.iter_mut().enumerate() {
                     let t = Instant::now();
-                    writers[i].push_rows(sampler.finish())?;
+                    sinks[i].push(sampler.finish())?;
                     busy[i] += t.elapsed().as_secs_f64();
                 }
                 Ok((samplers, busy))
             },
         );
         let mut dem = || -> Result<(), RecordError> {
-            let mut k = 0;
+            let mut k = start;
             while k < period_steps {
                 // sample k is the contact list that conducted during DEM step k, from
                 // t0 + k dt to t0 + (k+1) dt: the list the step has just computed
@@ -298,7 +862,7 @@ fn record_period(
                     let mut contacts = spare.try_recv().unwrap_or_default();
                     contacts.clear();
                     contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
-                    if to_recorder.send((k, contacts)).is_err() {
+                    if to_recorder.send(ToRecorder::Sample(k, contacts)).is_err() {
                         return Ok(()); // the recorder stopped: its error is reported below
                     }
                 }
@@ -310,6 +874,18 @@ fn record_period(
                 if k % REPORT_EVERY < stride || k == period_steps {
                     progress(Phase::Period, k, period_steps);
                 }
+                if let Some(c) = checkpoints.as_deref_mut() {
+                    if k < period_steps && c.due() {
+                        let (reply, state) = mpsc::channel();
+                        if to_recorder.send(ToRecorder::Checkpoint(reply)).is_err() {
+                            return Ok(());
+                        }
+                        let Ok(state) = state.recv() else {
+                            return Ok(()); // the recorder stopped: its error is reported below
+                        };
+                        c.save(sim, k, state)?;
+                    }
+                }
             }
             Ok(())
         };
@@ -317,12 +893,13 @@ fn record_period(
         drop(to_recorder);
         let recorded = recorder.join().expect("the recorder thread does not panic");
         dem_result?;
-        Ok(recorded?)
+        recorded
     })
 }
 
 /// What a recording's info takes from the run at `t0`, whichever engine made it.
-pub(crate) struct RunAtT0 {
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
+pub struct RunAtT0 {
     pub particles: u32,
     /// Largest particle radius (m): the span of the `sqrt(a)` codes.
     pub r_max: f64,
@@ -330,6 +907,20 @@ pub(crate) struct RunAtT0 {
     /// Simulated time and step count at `t0`.
     pub t0: f64,
     pub step_t0: u64,
+}
+
+impl RunAtT0 {
+    /// The run of `sim`, standing at `t0`.
+    fn of(sim: &Simulation) -> Self {
+        let particles = sim.particles.len() as u32;
+        Self {
+            particles,
+            r_max: sim.particles.radius.iter().cloned().fold(0.0, f64::max),
+            walls: wall_infos(&sim.walls, particles),
+            t0: sim.time,
+            step_t0: sim.step,
+        }
+    }
 }
 
 /// The walls of the case's drum as table bodies `particles + w`, with their fixed

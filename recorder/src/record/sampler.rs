@@ -7,7 +7,7 @@ use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 
 /// A contact seen at the previous sample, with its row in progress.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct OpenContact {
     row_start: u64,
     samples: u32,
@@ -21,7 +21,7 @@ struct OpenContact {
 
 /// Rows by apparition rank, from the oldest not yet released: `None` while in progress.
 /// Spans at most the rows started within `Δt_c^max`, since no row stays open longer.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
 struct RowWindow {
     /// Rank of `slots[0]`.
     base: u64,
@@ -69,7 +69,7 @@ impl OpenContact {
 }
 
 /// Builds the collision table of one period from samples of the DEM contact list.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct ContactSampler {
     /// Sampling factor `n` (steps per sample).
     pub every: u32,
@@ -99,6 +99,37 @@ impl ContactSampler {
             last_sample: None,
             histogram: Vec::new(),
         })
+    }
+
+    /// Checks a sampler read back from a checkpoint: every row in progress has its slot in
+    /// the window of unreleased rows, and no slot is claimed twice.
+    pub fn check(&self) -> Result<(), String> {
+        let mut claimed = vec![false; self.done.slots.len()];
+        for (key, c) in &self.open {
+            if c.samples == 0 {
+                continue;
+            }
+            let slot = c.seq.checked_sub(self.done.base).map(|s| s as usize);
+            match slot.filter(|&s| s < claimed.len() && self.done.slots[s].is_none()) {
+                Some(s) if !claimed[s] => claimed[s] = true,
+                _ => {
+                    return Err(format!(
+                        "open contact {key:?} has row rank {} outside the unreleased rows {}..{}",
+                        c.seq,
+                        self.done.base,
+                        self.done.base + claimed.len() as u64
+                    ))
+                }
+            }
+        }
+        let waiting = self.done.slots.iter().filter(|s| s.is_none()).count();
+        let in_progress = claimed.iter().filter(|&&c| c).count();
+        if waiting != in_progress {
+            return Err(format!(
+                "{waiting} rows wait for {in_progress} contacts in progress"
+            ));
+        }
+        Ok(())
     }
 
     /// Number of contacts currently open.

@@ -1,0 +1,403 @@
+//! Checkpoints of `tdex record`: the whole state of a run in one file, written atomically,
+//! from which `tdex record --resume` goes on to the same bytes as an uninterrupted run.
+//!
+//! A checkpoint holds what the next step depends on — the particles in their memory order,
+//! the Verlet list with every contact history, the drum's motion, the step count — and what
+//! the output has received: the snapshots, the sampler with its open contacts and the
+//! [`JournalMark`] of the rows. Everything else (step parameters, cell grid, walls) is rebuilt
+//! from the case text stored inside. The engine draws no random numbers after insertion (the
+//! seeded lattice of [`crate::insertion`]), so there is no generator state to keep.
+//!
+//! Layout: one line of text saying what the file is and where the run stands (`head -1`
+//! shows it), then the body's length (u64) and CRC-32 (u32), little-endian, then the body in
+//! postcard's serde encoding (floats as their 8 bytes: a state read back is the state saved,
+//! bit for bit).
+
+use super::journal::JournalMark;
+use super::recording::{RecordOptions, RunAtT0};
+use super::ContactSampler;
+use crate::case::Case;
+use crate::counters::Counters;
+use crate::format::Snapshot;
+use crate::neighbor::NeighborList;
+use crate::particles::ParticleSet;
+use crate::pipeline::ContactCount;
+use crate::simulation::Groups;
+use crate::Simulation;
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Format of the body; a reader refuses others.
+pub const CHECKPOINT_VERSION: u32 = 1;
+const HEADER_PREFIX: &str = "tdex checkpoint v";
+/// The header line is at most this long (a reader does not scan a large file for it).
+const MAX_HEADER: usize = 512;
+
+/// Where a run stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Stage {
+    /// `done` steps of the settling.
+    Settle { done: u64 },
+    /// `done` steps of the spin-up.
+    SpinUp { done: u64 },
+    /// `done` steps of the recorded period `[t0, t1]`.
+    Period { done: u64 },
+    /// `done` steps into reference period `period` (0-based; the ones before it are stored).
+    Reference { period: u32, done: u64 },
+}
+
+/// Wall-clock seconds spent so far, as the costs record reports them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct Elapsed {
+    pub to_t0: f64,
+    pub period: f64,
+    pub recorder: f64,
+    pub reference: f64,
+}
+
+/// The engine state a step depends on.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct EngineState<'a> {
+    pub particles: Cow<'a, ParticleSet>,
+    pub neighbors: Cow<'a, NeighborList>,
+    pub angular_velocity: f64,
+    pub mantle_temperature: Option<f64>,
+    pub groups: Cow<'a, Groups>,
+    pub time: f64,
+    pub step: u64,
+    pub last_contacts: ContactCount,
+    pub counters: Cow<'a, Counters>,
+}
+
+impl<'a> EngineState<'a> {
+    /// Borrows the state of `sim` (nothing is copied to save it).
+    pub fn of(sim: &'a Simulation) -> Self {
+        Self {
+            particles: Cow::Borrowed(&sim.particles),
+            neighbors: Cow::Borrowed(&sim.neighbors),
+            angular_velocity: sim.walls.angular_velocity,
+            mantle_temperature: sim.walls.mantle_temperature,
+            groups: Cow::Borrowed(&sim.groups),
+            time: sim.time,
+            step: sim.step,
+            last_contacts: sim.last_contacts,
+            counters: Cow::Borrowed(&sim.counters),
+        }
+    }
+}
+
+/// What the recording has received once the run is past `t0`.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct OutputState<'a> {
+    pub run: RunAtT0,
+    /// `t0`, then `t1` and the reference snapshots written so far.
+    pub snapshots: Cow<'a, [Snapshot]>,
+    pub sampler: Cow<'a, ContactSampler>,
+    pub journal: JournalMark,
+    /// The partial output of the process that wrote the checkpoint (a resume removes it).
+    pub partial: PathBuf,
+}
+
+/// A run of `tdex record`, resumable.
+#[derive(Debug, Serialize, Deserialize)]
+pub struct Checkpoint<'a> {
+    pub tool_version: String,
+    pub case_toml: Cow<'a, str>,
+    /// The case path as the recording's metadata states it.
+    pub case_path: PathBuf,
+    pub options: RecordOptions,
+    /// The recording (absolute path).
+    pub dest: PathBuf,
+    /// Wall-clock seconds between checkpoints.
+    pub every_seconds: f64,
+    /// Whether the recording gets its `tdex.costs` record.
+    pub write_costs: bool,
+    pub stage: Stage,
+    pub elapsed: Elapsed,
+    pub engine: EngineState<'a>,
+    pub output: Option<OutputState<'a>>,
+    /// The first line of the file as read (what the run was at), not part of the body.
+    #[serde(skip)]
+    pub header: String,
+}
+
+/// Why a checkpoint cannot be written, read or resumed.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("{}: cannot read the checkpoint: {error}", path.display())]
+    Read {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{}: cannot write the checkpoint: {error}", path.display())]
+    Write {
+        path: PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{}: not a tdex checkpoint (its first line does not start with '{HEADER_PREFIX}')", path.display())]
+    NotCheckpoint { path: PathBuf },
+    #[error("{}: checkpoint format v{found}; this tdex reads v{CHECKPOINT_VERSION}", path.display())]
+    Version { path: PathBuf, found: String },
+    #[error("{}: damaged checkpoint: {detail}", path.display())]
+    Damaged { path: PathBuf, detail: String },
+    #[error("{}: written by tdex {found}, this is tdex {}: resume with the tdex that wrote it", path.display(), env!("CARGO_PKG_VERSION"))]
+    ToolVersion { path: PathBuf, found: String },
+    #[error("{}: the checkpoint does not fit its own case: {detail}", path.display())]
+    Inconsistent { path: PathBuf, detail: String },
+}
+
+impl CheckpointError {
+    /// Whether the error is in the file the user gave (exit code 2), not in writing one.
+    pub fn is_bad_input(&self) -> bool {
+        !matches!(self, CheckpointError::Write { .. })
+    }
+}
+
+impl Checkpoint<'_> {
+    /// Writes the checkpoint to `path` atomically: a hidden partial file beside it, synced,
+    /// renamed over the previous checkpoint, and the directory synced. `header` is the text
+    /// after the version on the first line.
+    pub fn write(&self, path: &Path, header: &str) -> Result<(), CheckpointError> {
+        let write_err = |error| CheckpointError::Write {
+            path: path.to_path_buf(),
+            error,
+        };
+        let body = postcard::to_stdvec(self).map_err(|e| write_err(std::io::Error::other(e)))?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "tdex.checkpoint".into());
+        let partial = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
+        let written = (|| -> std::io::Result<()> {
+            let mut file = std::fs::File::create(&partial)?;
+            let line = format!(
+                "{HEADER_PREFIX}{CHECKPOINT_VERSION}: {}\n",
+                header.replace('\n', " ")
+            );
+            let mut head = line.into_bytes();
+            head.extend_from_slice(&(body.len() as u64).to_le_bytes());
+            head.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
+            file.write_all(&head)?;
+            file.write_all(&body)?;
+            file.sync_all()?;
+            std::fs::rename(&partial, path)?;
+            sync_dir(path)
+        })();
+        if written.is_err() {
+            let _ = std::fs::remove_file(&partial);
+        }
+        written.map_err(write_err)
+    }
+}
+
+/// Syncs the directory holding `path`, so that a rename in it survives a crash.
+pub(crate) fn sync_dir(path: &Path) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    std::fs::File::open(dir)?.sync_all()
+}
+
+impl Checkpoint<'static> {
+    /// Reads and checks a checkpoint file: header, version, length, CRC and decoding. The
+    /// state is checked against its case by [`Self::restore`].
+    pub fn read(path: &Path) -> Result<Self, CheckpointError> {
+        let bytes = std::fs::read(path).map_err(|error| CheckpointError::Read {
+            path: path.to_path_buf(),
+            error,
+        })?;
+        let damaged = |detail: String| CheckpointError::Damaged {
+            path: path.to_path_buf(),
+            detail,
+        };
+        let head = &bytes[..bytes.len().min(MAX_HEADER)];
+        let Some(newline) = head.iter().position(|&b| b == b'\n') else {
+            return Err(CheckpointError::NotCheckpoint {
+                path: path.to_path_buf(),
+            });
+        };
+        let line = String::from_utf8_lossy(&bytes[..newline]);
+        let Some(rest) = line.strip_prefix(HEADER_PREFIX) else {
+            return Err(CheckpointError::NotCheckpoint {
+                path: path.to_path_buf(),
+            });
+        };
+        let version = rest.split(':').next().unwrap_or("").trim();
+        if version != CHECKPOINT_VERSION.to_string() {
+            return Err(CheckpointError::Version {
+                path: path.to_path_buf(),
+                found: version.chars().take(20).collect(),
+            });
+        }
+        let after = &bytes[newline + 1..];
+        if after.len() < 12 {
+            return Err(damaged(format!(
+                "{} bytes after the header line, at least 12 needed (length and CRC)",
+                after.len()
+            )));
+        }
+        let length = u64::from_le_bytes(after[..8].try_into().expect("8 bytes"));
+        let crc = u32::from_le_bytes(after[8..12].try_into().expect("4 bytes"));
+        let body = &after[12..];
+        if length != body.len() as u64 {
+            return Err(damaged(format!(
+                "the header announces a body of {length} bytes, the file holds {} (cut short or extended)",
+                body.len()
+            )));
+        }
+        let found = crc32fast::hash(body);
+        if found != crc {
+            return Err(damaged(format!(
+                "CRC-32 of the body is {found:08x}, the header says {crc:08x}"
+            )));
+        }
+        // `Cow` fields decode owned (no borrow from `bytes`)
+        let mut checkpoint: Checkpoint<'static> = postcard::from_bytes(body)
+            .map_err(|e| damaged(format!("the body does not decode: {e}")))?;
+        if checkpoint.tool_version != env!("CARGO_PKG_VERSION") {
+            return Err(CheckpointError::ToolVersion {
+                path: path.to_path_buf(),
+                found: checkpoint.tool_version.chars().take(40).collect(),
+            });
+        }
+        checkpoint.header = line.into_owned();
+        Ok(checkpoint)
+    }
+
+    /// The case the checkpoint was taken in, parsed and validated again from its text.
+    pub fn case(&self, path: &Path) -> Result<Case, CheckpointError> {
+        crate::case::parse(&self.case_toml, &self.case_path).map_err(|e| {
+            CheckpointError::Inconsistent {
+                path: path.to_path_buf(),
+                detail: format!("its case text is refused: {e}"),
+            }
+        })
+    }
+
+    /// Rebuilds the simulation of `case` with the saved state, after checking that every
+    /// index the engine and the recorder will follow is in range (a checkpoint that passed
+    /// its CRC can still have been written by hand). `period_steps` and `reference_periods`
+    /// bound the stage; `path` is for messages.
+    pub fn restore(
+        self,
+        case: &Case,
+        path: &Path,
+    ) -> Result<(Simulation, Stage, Elapsed, Option<OutputState<'static>>), CheckpointError> {
+        let bad = |detail: String| CheckpointError::Inconsistent {
+            path: path.to_path_buf(),
+            detail,
+        };
+        let mut sim = Simulation::new(case).map_err(|e| bad(e.to_string()))?;
+        let n = sim.particles.len();
+        let e = self.engine;
+        e.particles.check(n).map_err(&bad)?;
+        e.neighbors
+            .check(n, sim.pipeline.grid.layers(), sim.walls.len())
+            .map_err(&bad)?;
+        if e.neighbors.skin != sim.neighbors.skin {
+            return Err(bad(format!(
+                "Verlet skin {} m, the case gives {} m",
+                e.neighbors.skin, sim.neighbors.skin
+            )));
+        }
+        if !e.groups.hot.is_empty() && e.groups.hot.len() != n {
+            return Err(bad(format!(
+                "{} group flags for {n} particles",
+                e.groups.hot.len()
+            )));
+        }
+        if e.time != e.step as f64 * case.time.dt {
+            return Err(bad(format!(
+                "t = {} s is not step {} × dt = {} s",
+                e.time, e.step, case.time.dt
+            )));
+        }
+        let o = &self.options;
+        let (settle, spin) = (
+            case.steps_in(case.time.settle),
+            case.steps_in(case.time.spin_up),
+        );
+        let (stage_ok, snapshots) = match self.stage {
+            Stage::Settle { done } => (done <= settle, None),
+            Stage::SpinUp { done } => (done <= spin, None),
+            Stage::Period { done } => (
+                done <= o.period_steps && done % o.sample_every.max(1) as u64 == 0,
+                Some(1),
+            ),
+            Stage::Reference { period, done } => (
+                period < o.reference_periods && done <= o.period_steps,
+                Some(2 + period as usize),
+            ),
+        };
+        if !stage_ok {
+            return Err(bad(format!(
+                "stage {:?} is outside the run ({settle} settling, {spin} spin-up steps, period of {} steps sampled every {}, {} reference periods)",
+                self.stage, o.period_steps, o.sample_every, o.reference_periods
+            )));
+        }
+        match (&self.output, snapshots) {
+            (None, None) => {}
+            (Some(out), Some(count)) => {
+                if out.snapshots.len() != count {
+                    return Err(bad(format!(
+                        "{} snapshots stored at stage {:?}, {count} expected",
+                        out.snapshots.len(),
+                        self.stage
+                    )));
+                }
+                if let Some(s) = out.snapshots.iter().find(|s| {
+                    [
+                        s.id.len(),
+                        s.pos.len(),
+                        s.radius.len(),
+                        s.temp.len(),
+                        s.vel.len(),
+                    ]
+                    .iter()
+                    .any(|&len| len != n)
+                }) {
+                    return Err(bad(format!(
+                        "snapshot {} does not hold {n} particles",
+                        s.index
+                    )));
+                }
+                if out.run.particles as usize != n || out.run.walls.len() != sim.walls.len() {
+                    return Err(bad(format!(
+                        "the recording's {} particles and {} walls differ from the case's {n} and {}",
+                        out.run.particles,
+                        out.run.walls.len(),
+                        sim.walls.len()
+                    )));
+                }
+                let s = &out.sampler;
+                if s.every != o.sample_every || s.max_duration != o.dtc_max_steps {
+                    return Err(bad(format!(
+                        "the sampler has n = {}, Δt_c^max = {}; the options say {} and {}",
+                        s.every, s.max_duration, o.sample_every, o.dtc_max_steps
+                    )));
+                }
+                s.check().map_err(&bad)?;
+            }
+            (out, _) => {
+                return Err(bad(format!(
+                    "stage {:?} {} recording state",
+                    self.stage,
+                    if out.is_some() { "has a" } else { "lacks the" }
+                )))
+            }
+        }
+        sim.particles = e.particles.into_owned();
+        sim.neighbors = e.neighbors.into_owned();
+        sim.walls.angular_velocity = e.angular_velocity;
+        sim.walls.mantle_temperature = e.mantle_temperature;
+        sim.groups = e.groups.into_owned();
+        sim.time = e.time;
+        sim.step = e.step;
+        sim.last_contacts = e.last_contacts;
+        sim.counters = e.counters.into_owned();
+        Ok((sim, self.stage, self.elapsed, self.output))
+    }
+}

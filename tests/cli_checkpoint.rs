@@ -1,0 +1,283 @@
+//! `tdex record --checkpoint-every` / `--resume`: a run killed with SIGKILL after a
+//! checkpoint, in any stage, resumes to the recording an uninterrupted run writes, byte for
+//! byte; damaged checkpoints and journals are refused with a clear error.
+
+use crate::util::{run_tdex, tdex};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A heated drum of 600 particles: 2 000 settling, 1 000 spin-up steps, then the period.
+const CASE: &str = r#"
+name = "checkpointed"
+seed = 5
+[particles]
+count = 600
+radius = 0.005
+[material]
+density = 2500.0
+youngs_modulus = 1.0e7
+poisson_ratio = 0.3
+conductivity = 100.0
+heat_capacity = 840.0
+[contact]
+particle_particle = { restitution = 0.2, friction = 0.3, rolling_friction = 0.002 }
+particle_wall = { restitution = 0.2, friction = 0.5, rolling_friction = 0.002 }
+[drum]
+radius = 0.06
+length = 0.1
+rotation_period = 1.0
+wall_temperature = 350.0
+[time]
+dt = 1.0e-4
+settle = 0.2
+spin_up = 0.1
+heating = 0.2
+[temperature]
+mode = "split"
+hot = 30.0
+cold = 10.0
+"#;
+
+/// τ = 0.6 s (6 000 steps) and two reference periods.
+const TABLE: [&str; 4] = ["--tau", "0.6", "--reference", "2"];
+
+fn setup(dir: &Path) -> PathBuf {
+    let case = dir.join("case.toml");
+    std::fs::write(&case, CASE).unwrap();
+    case
+}
+
+fn checkpoint_of(out: &Path) -> PathBuf {
+    PathBuf::from(format!("{}.checkpoint", out.display()))
+}
+
+fn record_args<'a>(case: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec![
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend(TABLE);
+    args.extend(extra);
+    args
+}
+
+fn spawn(args: &[&str]) -> Child {
+    Command::new(tdex())
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("tdex starts")
+}
+
+/// Waits until the checkpoint's first line says the run is at `stage` (e.g. "period step"),
+/// then kills the run with SIGKILL. Fails if the run ends first.
+fn kill_at(child: Child, checkpoint: &Path, stage: &str) -> String {
+    kill_when(child, checkpoint, stage, |line| line.contains(stage))
+}
+
+/// The step a checkpoint's first line states (`... step K of ...`).
+fn step_of(line: &str) -> u64 {
+    let after = line.rsplit_once(" step ").expect("a step").1;
+    after.split(' ').next().unwrap().parse().unwrap()
+}
+
+/// Kills the run with SIGKILL once the checkpoint's first line satisfies `ready`.
+fn kill_when(
+    mut child: Child,
+    checkpoint: &Path,
+    stage: &str,
+    ready: impl Fn(&str) -> bool,
+) -> String {
+    let start = Instant::now();
+    loop {
+        if let Ok(bytes) = std::fs::read(checkpoint) {
+            let line = String::from_utf8_lossy(&bytes[..bytes.len().min(300)])
+                .lines()
+                .next()
+                .unwrap_or("")
+                .to_string();
+            if ready(&line) {
+                child.kill().unwrap(); // SIGKILL
+                child.wait().unwrap();
+                return line;
+            }
+        }
+        if let Some(status) = child.try_wait().unwrap() {
+            let mut err = String::new();
+            use std::io::Read;
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
+            panic!("the run ended ({status}) before a checkpoint at '{stage}': {err}");
+        }
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "no checkpoint at '{stage}' after 300 s"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+}
+
+/// Names of the files in `dir`, hidden ones included.
+fn names(dir: &Path) -> Vec<String> {
+    let mut n: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    n.sort();
+    n
+}
+
+#[test]
+fn a_recording_killed_in_every_stage_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let o = run_tdex(&record_args(
+        &case,
+        &a,
+        &["--reproducible", "--threads", "2"],
+    ));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let ck = checkpoint_of(&b);
+    let ck_arg = ck.to_str().unwrap().to_string();
+    let every = ["--checkpoint-every", "0.02"];
+    let first = spawn(&record_args(
+        &case,
+        &b,
+        &["--reproducible", "--threads", "2", every[0], every[1]],
+    ));
+    let mut stops = vec![kill_at(first, &ck, "settle step")];
+    for (stage, threads) in [("period step", "1"), ("reference period 2 of 2", "2")] {
+        assert!(!b.exists(), "a killed run left {}", b.display());
+        let resumed = spawn(&["record", "--resume", &ck_arg, "--threads", threads]);
+        stops.push(kill_at(resumed, &ck, stage));
+    }
+    assert!(!b.exists(), "a killed run left {}", b.display());
+    let o = run_tdex(&["record", "--resume", &ck_arg]);
+    assert!(
+        o.status.success(),
+        "stops: {stops:#?}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (a_bytes, b_bytes) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+    assert_eq!(a_bytes.len(), b_bytes.len(), "stops: {stops:#?}");
+    assert!(
+        a_bytes == b_bytes,
+        "the resumed recording differs; stops: {stops:#?}"
+    );
+    // the checkpoint, its journal and the killed runs' partial files are gone
+    assert_eq!(names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
+}
+
+#[test]
+fn a_resumed_recording_with_costs_equals_an_uninterrupted_one_up_to_its_costs() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let o = run_tdex(&record_args(&case, &a, &[]));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ck = checkpoint_of(&b);
+    let run = spawn(&record_args(&case, &b, &["--checkpoint-every", "0.02"]));
+    kill_at(run, &ck, "period step");
+    let o = run_tdex(&["record", "--resume", ck.to_str().unwrap(), "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["costs_recorded"], true);
+    assert!(report["seconds_period"].as_f64().unwrap() > 0.0);
+
+    let (a, b) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+    let costs = |f: &[u8]| {
+        // the costs metadata record: opcode (1 byte) and length (8) before its name's length (4)
+        f.windows(10)
+            .position(|w| w == b"tdex.costs")
+            .expect("a costs record")
+            - 13
+    };
+    let (ca, cb) = (costs(&a), costs(&b));
+    assert_eq!(ca, cb, "the costs record starts at different offsets");
+    assert!(
+        a[..ca] == b[..cb],
+        "recordings differ before the costs record"
+    );
+}
+
+#[test]
+fn damaged_checkpoints_and_journals_are_refused_with_clear_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let out = dir.path().join("c.mcap");
+    let ck = checkpoint_of(&out);
+    let run = spawn(&record_args(&case, &out, &["--checkpoint-every", "0.02"]));
+    // far enough into the period that rows have been released to the journal
+    kill_when(run, &ck, "period step ≥ 1000", |l| {
+        l.contains("period step") && step_of(l) >= 1000
+    });
+    let good = std::fs::read(&ck).unwrap();
+    let journal = PathBuf::from(format!("{}.rows", ck.display()));
+    let good_journal = std::fs::read(&journal).unwrap();
+    assert!(!good_journal.is_empty());
+
+    let refused = |expect: &str| {
+        let o = run_tdex(&["record", "--resume", ck.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{expect}: {err}");
+        assert!(err.contains(expect), "expected '{expect}' in: {err}");
+        assert!(!out.exists());
+    };
+    let header_end = good.iter().position(|&b| b == b'\n').unwrap() + 1;
+    let mut flipped = good.clone();
+    flipped[header_end + 12 + 1000] ^= 0x10;
+    std::fs::write(&ck, &flipped).unwrap();
+    refused("damaged checkpoint: CRC-32");
+    std::fs::write(&ck, &good[..good.len() - 100]).unwrap();
+    refused("cut short");
+    std::fs::write(&ck, b"name = \"not a checkpoint\"\n").unwrap();
+    refused("not a tdex checkpoint");
+    std::fs::write(&ck, good.replacen_bytes(b"checkpoint v1", b"checkpoint v9")).unwrap();
+    refused("checkpoint format v9");
+
+    std::fs::write(&ck, &good).unwrap();
+    std::fs::write(&journal, &good_journal[..good_journal.len() / 2]).unwrap();
+    refused("the row journal holds");
+    let mut damaged = good_journal.clone();
+    damaged[10] ^= 1;
+    std::fs::write(&journal, &damaged).unwrap();
+    refused("do not match the checkpoint");
+
+    // flags that belong to the recording cannot change on resume; the interval must be > 0
+    let o = run_tdex(&["record", "--resume", ck.to_str().unwrap(), "--n", "5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+    let o = run_tdex(&record_args(&case, &out, &["--checkpoint-every", "0"]));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--checkpoint-every = 0 is not allowed"));
+
+    // the intact pair still resumes
+    std::fs::write(&journal, &good_journal).unwrap();
+    let o = run_tdex(&["record", "--resume", ck.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.exists() && !ck.exists() && !journal.exists());
+}
+
+trait ReplaceBytes {
+    fn replacen_bytes(&self, from: &[u8], to: &[u8]) -> Vec<u8>;
+}
+
+impl ReplaceBytes for Vec<u8> {
+    /// The bytes with the first occurrence of `from` replaced by `to` (same length).
+    fn replacen_bytes(&self, from: &[u8], to: &[u8]) -> Vec<u8> {
+        let at = self.windows(from.len()).position(|w| w == from).unwrap();
+        let mut out = self.clone();
+        out[at..at + to.len()].copy_from_slice(to);
+        out
+    }
+}
