@@ -294,6 +294,24 @@ impl Checkpoint<'static> {
         let n = sim.particles.len();
         let e = self.engine;
         e.particles.check(n).map_err(&bad)?;
+        // sizes and masses are the case's (the inserted set has them by id); the state is
+        // finite and inside the drum, as the engine keeps it
+        let inserted = &sim.particles;
+        let p = &e.particles;
+        for i in 0..n {
+            let id = p.id[i] as usize;
+            let finite = [p.pos[i], p.vel[i], p.omega[i], p.force[i], p.torque[i]]
+                .iter()
+                .flatten()
+                .chain([&p.temp[i], &p.heat_flow[i]])
+                .all(|x| x.is_finite());
+            if p.radius[i] != inserted.radius[id] || p.mass[i] != inserted.mass[id] || !finite {
+                return Err(bad(format!(
+                    "particle {id} (slot {i}): radius {} m, mass {} kg, or a non-finite state value; the case gives {} m, {} kg",
+                    p.radius[i], p.mass[i], inserted.radius[id], inserted.mass[id]
+                )));
+            }
+        }
         e.neighbors
             .check(n, sim.pipeline.grid.layers(), sim.walls.len())
             .map_err(&bad)?;
@@ -379,7 +397,26 @@ impl Checkpoint<'static> {
                         s.every, s.max_duration, o.sample_every, o.dtc_max_steps
                     )));
                 }
-                s.check().map_err(&bad)?;
+                s.check(o.period_steps / o.sample_every.max(1) as u64)
+                    .map_err(&bad)?;
+                if let Some((k, s)) = out
+                    .snapshots
+                    .iter()
+                    .enumerate()
+                    .find(|(k, s)| s.index as usize != *k)
+                {
+                    return Err(bad(format!("snapshot {k} is numbered {}", s.index)));
+                }
+                let (t0_step, r) = (settle + spin, case.particles.radius);
+                if out.run.step_t0 != t0_step
+                    || out.run.t0 != t0_step as f64 * case.time.dt
+                    || out.run.r_max != r
+                {
+                    return Err(bad(format!(
+                        "t0 at step {} ({} s) with largest radius {} m; the case gives step {t0_step} and {r} m",
+                        out.run.step_t0, out.run.t0, out.run.r_max
+                    )));
+                }
             }
             (out, _) => {
                 return Err(bad(format!(
@@ -398,6 +435,7 @@ impl Checkpoint<'static> {
         sim.step = e.step;
         sim.last_contacts = e.last_contacts;
         sim.counters = e.counters.into_owned();
+        sim.check_inside().map_err(|e| bad(e.to_string()))?;
         Ok((sim, self.stage, self.elapsed, self.output))
     }
 }

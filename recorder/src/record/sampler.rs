@@ -101,9 +101,26 @@ impl ContactSampler {
         })
     }
 
-    /// Checks a sampler read back from a checkpoint: every row in progress has its slot in
-    /// the window of unreleased rows, and no slot is claimed twice.
-    pub fn check(&self) -> Result<(), String> {
+    /// Checks a sampler read back from a checkpoint, in a period of `max_samples` samples:
+    /// every row in progress has its slot in the window of unreleased rows, no slot is
+    /// claimed twice, and no count exceeds what the period allows (the histogram grows to
+    /// the longest collision).
+    pub fn check(&self, max_samples: u64) -> Result<(), String> {
+        let row_samples = (self.max_duration / self.every.max(1)) as u64;
+        if let Some((key, c)) = self.open.iter().find(|(_, c)| {
+            c.collision_samples as u64 > max_samples || c.samples as u64 > row_samples
+        }) {
+            return Err(format!(
+                "open contact {key:?} counts {} samples ({} in its row); the period has {max_samples}, a row at most {row_samples}",
+                c.collision_samples, c.samples
+            ));
+        }
+        if self.histogram.len() as u64 > max_samples + 1 {
+            return Err(format!(
+                "a histogram of {} collision lengths exceeds a period of {max_samples} samples",
+                self.histogram.len()
+            ));
+        }
         let mut claimed = vec![false; self.done.slots.len()];
         for (key, c) in &self.open {
             if c.samples == 0 {
