@@ -53,9 +53,16 @@ pub fn run(plan: RecordPlan) -> Result<()> {
                 write_costs: !reproducible,
             };
             if checkpoint_every.is_some() {
+                let checkpoint = record::checkpoint_path(&output);
+                if checkpoint.exists() {
+                    eprintln!(
+                        "warning: {} is left from an earlier run; this run replaces it (to continue that run instead: tdex record --resume {0})",
+                        checkpoint.display()
+                    );
+                }
                 eprintln!(
                     "checkpoints to {} (resume with: tdex record --resume {0})",
-                    record::checkpoint_path(&output).display()
+                    checkpoint.display()
                 );
             }
             crate::with_workers(plan.threads, || {
