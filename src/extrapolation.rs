@@ -44,7 +44,11 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         Some(stored) => (stored, true),
         None => {
             let stored = pair::compute(&t0, &t1)?;
-            pair::store(&reader, &stored)?;
+            // the stored pairing only saves time next run: a recording on a full or read-only
+            // disk is still extrapolated
+            if let Err(e) = pair::store(&reader, &stored) {
+                eprintln!("warning: {e:#}; the pairing will be computed again next time");
+            }
             (stored, false)
         }
     };
