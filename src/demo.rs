@@ -47,6 +47,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         output: extra.clone(),
         scheme: Scheme::Explicit,
         stream: false,
+        max_memory: None,
         threads: plan.threads,
         json: false,
     })?;

@@ -6,6 +6,7 @@ mod util;
 mod cli_case_errors;
 mod cli_compare;
 mod cli_export;
+mod cli_extrapolate;
 mod cli_import;
 mod cli_outputs;
 mod cli_record;

@@ -104,6 +104,7 @@ pub fn evaluate(
         output: extra.to_path_buf(),
         scheme: Scheme::Explicit,
         stream: false,
+        max_memory: None,
         threads,
         json: true,
     };
