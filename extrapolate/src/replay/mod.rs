@@ -33,7 +33,7 @@ pub enum ReplayError {
          allow more with --max-memory (at least {}) or free memory",
         memory::human_bytes(*needed),
         memory::human_bytes(*particle_bytes),
-        memory::human_bytes(*pairing_bytes),
+        if *pairing_bytes == 0 { "stored".to_string() } else { memory::human_bytes(*pairing_bytes) },
         memory::human_bytes(*buffer_bytes),
         memory::human_bytes(*limit),
         memory::human_bytes(*needed)
