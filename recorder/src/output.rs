@@ -58,13 +58,27 @@ impl OutputError {
         }
     }
 
+    /// The directory of `dest` could not be fsynced after the rename: the new file is in
+    /// place, but a crash could still undo the rename.
+    pub fn syncing_dir(dest: &Path, error: io::Error) -> Self {
+        Self {
+            dest: dest.to_path_buf(),
+            action: "sync the directory after writing",
+            dir: parent_dir(dest).to_path_buf(),
+            previous: true,
+            error,
+        }
+    }
+
     /// The I/O error kind behind it (`StorageFull`, `PermissionDenied`, ...).
     pub fn kind(&self) -> ErrorKind {
         self.error.kind()
     }
 
     fn previous_note(&self) -> String {
-        if self.action != "write" {
+        if self.action.starts_with("sync") {
+            "the new file is in place, but a crash may still undo its rename".into()
+        } else if self.action != "write" {
             "nothing was created".into()
         } else if self.previous {
             format!(
@@ -195,7 +209,7 @@ impl AtomicFile {
     pub fn commit(self) -> Result<PathBuf, OutputError> {
         let staged = self.stage()?;
         let dest = staged.rename()?;
-        sync_dir(parent_dir(&dest)).map_err(|e| OutputError::writing(&dest, e))?;
+        sync_dir(parent_dir(&dest)).map_err(|e| OutputError::syncing_dir(&dest, e))?;
         Ok(dest)
     }
 }
@@ -252,7 +266,7 @@ impl Staged {
     /// Renames into place and fsyncs the directory.
     pub fn commit(self) -> Result<PathBuf, OutputError> {
         let dest = self.rename()?;
-        sync_dir(parent_dir(&dest)).map_err(|e| OutputError::writing(&dest, e))?;
+        sync_dir(parent_dir(&dest)).map_err(|e| OutputError::syncing_dir(&dest, e))?;
         Ok(dest)
     }
 }
@@ -311,7 +325,7 @@ impl OutputSet {
         for dest in &written {
             let dir = parent_dir(dest);
             if synced != Some(dir) {
-                sync_dir(dir).map_err(|e| OutputError::writing(dest, e))?;
+                sync_dir(dir).map_err(|e| OutputError::syncing_dir(dest, e))?;
                 synced = Some(dir);
             }
         }
