@@ -3,7 +3,7 @@
 
 use crate::cli::{DemoPlan, ExtrapolatePlan, RecordPlan, RecordStart};
 use crate::{compare, extrapolation, record, report};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::format::{ExtrapolationReader, RecordingReader};
 
@@ -14,10 +14,9 @@ pub const PERIODS: u32 = 6;
 
 pub fn run(plan: &DemoPlan) -> Result<()> {
     let dir = &plan.output;
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    recorder::output::create_dir_all(dir)?;
     let case_path = dir.join("small_drum.toml");
-    std::fs::write(&case_path, CASE_TOML)
-        .with_context(|| format!("cannot write {}", case_path.display()))?;
+    recorder::output::write_atomically(&case_path, CASE_TOML.as_bytes())?;
     let (case, case_toml) = recorder::case::load_with_text(&case_path)?;
     let recording = dir.join("run.mcap");
     let extra = dir.join("extra.mcap");
@@ -52,6 +51,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         output: extra.clone(),
         scheme: Scheme::Explicit,
         stream: false,
+        max_memory: None,
         threads: plan.threads,
         json: false,
     })?;

@@ -2,9 +2,10 @@
 //! file, and a `.pvd` series that ParaView opens in one click.
 
 use crate::cli::{ExportVtkPlan, UsageError};
-use anyhow::{Context, Result};
+use anyhow::Result;
 use recorder::export::vtk::{self, ExtraArray};
 use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
+use recorder::output::OutputSet;
 use std::path::{Path, PathBuf};
 
 /// Name of the per-particle difference array of an extrapolation with its reference.
@@ -17,8 +18,9 @@ pub fn run(plan: &ExportVtkPlan) -> Result<()> {
     Ok(())
 }
 
-/// Writes the `.vtp` files, then the `.pvd` (each through a temporary file renamed into
-/// place, the series last); returns the files written.
+/// Writes the `.vtp` files, then the `.pvd`, all to temporary files first, renamed into
+/// place only when every one is written (the series last): a failure leaves the previous
+/// series whole. Returns the files written.
 pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
     let (snapshots, reference) = match open(&plan.file)? {
         Opened::Recording(r) => {
@@ -56,9 +58,8 @@ pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
         .file
         .file_stem()
         .map_or("tdex".into(), |s| s.to_string_lossy().into_owned());
-    std::fs::create_dir_all(&plan.output)
-        .with_context(|| format!("{}: cannot create the directory", plan.output.display()))?;
-    let mut written = Vec::new();
+    recorder::output::create_dir_all(&plan.output)?;
+    let mut set = OutputSet::new();
     let mut series = Vec::new();
     for snap in &snapshots {
         let name = format!("{stem}_{:04}.vtp", snap.index);
@@ -74,20 +75,12 @@ pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
             })
             .collect();
         let xml = vtk::polydata(snap, &extra);
-        written.push(crate::report::write_atomically(
-            &plan.output,
-            &name,
-            xml.as_bytes(),
-        )?);
+        set.add(&plan.output.join(&name), xml.as_bytes())?;
         series.push((snap.time, name));
     }
     let pvd = format!("{stem}.pvd");
-    written.push(crate::report::write_atomically(
-        &plan.output,
-        &pvd,
-        vtk::collection(&series).as_bytes(),
-    )?);
-    Ok(written)
+    set.add(&plan.output.join(pvd), vtk::collection(&series).as_bytes())?;
+    Ok(set.commit()?)
 }
 
 enum Opened {

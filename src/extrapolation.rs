@@ -3,7 +3,11 @@
 use crate::cli::ExtrapolatePlan;
 use crate::pair;
 use anyhow::{Context, Result};
-use extrapolate::replay::{self, Bodies, Exchange, Scheme, SyncScratch, Table};
+use extrapolate::replay::memory::human_bytes;
+use extrapolate::replay::{
+    self, Bodies, Exchange, MemoryNeeds, MemoryPlan, ModeReason, Scheme, SyncScratch, Table,
+    TableMode,
+};
 use recorder::format::{
     ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingReader, FORMAT_VERSION,
 };
@@ -20,6 +24,7 @@ pub struct ExtrapolationReport {
     rows: u64,
     max_cfl: f64,
     table_in_memory: bool,
+    memory: MemoryReport,
     pairing: pair::PairingSummary,
     costs: ExtrapolationCosts,
     total_heat_t1: f64,
@@ -38,13 +43,37 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
     let info = reader.info().clone();
     let (t0, t1) = pair::period_snapshots(&reader)?;
     let bodies = Bodies::of(&info, &t0);
+    let stored_pairing = pair::load(&reader, &t0, &t1);
+
+    // the memory it will need, stated and held against the limit before the pairing and
+    // the replay start: a table that does not fit is streamed, never left to the OOM killer
+    let limit = match plan.max_memory {
+        Some(bytes) => MemoryLimit {
+            bytes,
+            source: "--max-memory".into(),
+        },
+        None => MemoryLimit::available(),
+    };
+    let needs = MemoryNeeds::estimate(
+        info.particles as u64,
+        reader.table_rows(),
+        reader.largest_table_chunk(),
+        stored_pairing.is_some(),
+    );
+    let memory = MemoryPlan::choose(needs, limit.bytes, &limit.source, plan.stream)
+        .with_context(|| format!("{}", plan.file.display()))?;
+    eprintln!("{}", memory_statement(&memory, &limit));
 
     let started = Instant::now();
-    let (stored, reused) = match pair::load(&reader, &t0, &t1) {
+    let (stored, reused) = match stored_pairing {
         Some(stored) => (stored, true),
         None => {
             let stored = pair::compute(&t0, &t1)?;
-            pair::store(&reader, &stored)?;
+            // the stored pairing only saves time next run: a recording on a full or read-only
+            // disk is still extrapolated
+            if let Err(e) = pair::store(&reader, &stored) {
+                eprintln!("warning: {e:#}; the pairing will be computed again next time");
+            }
             (stored, false)
         }
     };
@@ -56,7 +85,7 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
 
     // the table: decoded once into memory, or streamed from the file each period
     let t = Instant::now();
-    let (table, rows, worst) = if plan.stream {
+    let (table, rows, worst) = if memory.mode == TableMode::Streamed {
         let found = replay::scan(&reader, &bodies, |_, _| {})?;
         (None, found.rows, found.worst)
     } else {
@@ -145,12 +174,165 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         rows,
         max_cfl,
         table_in_memory: table.is_some(),
+        memory: MemoryReport::of(&memory, &limit),
         pairing: stored.summary.clone(),
         costs,
         total_heat_t1: heat_t1,
         total_heat_end: replay::total_heat(&temps, &bodies),
     };
     Ok(report)
+}
+
+/// Rows a second that decoding the table costs, each period, when it is streamed: the
+/// `bench_drum` recording (23.2 million rows) replays in 1.02 s per period streamed against
+/// 0.101 s in memory (docs/benchmarks.md), 0.92 s to decode them.
+const STREAM_DECODE_ROWS_PER_SECOND: f64 = 2.5e7;
+
+/// The memory an extrapolation may use, and where that figure came from.
+pub struct MemoryLimit {
+    pub bytes: u64,
+    pub source: String,
+}
+
+impl MemoryLimit {
+    /// The default: 80 % of what the machine can still give (`MemAvailable` in
+    /// /proc/meminfo) and of what the process's cgroup still allows (`memory.max` −
+    /// `memory.current`, cgroup v2), whichever is smaller. The 20 % left is for the page
+    /// cache holding the recording and for the rest of the machine. Without /proc/meminfo
+    /// there is no limit (the table is held in memory, as before `--max-memory`).
+    pub fn available() -> Self {
+        let mut found: Vec<(u64, &str)> = Vec::new();
+        if let Some(kb) = std::fs::read_to_string("/proc/meminfo")
+            .ok()
+            .and_then(|text| meminfo_kb(&text, "MemAvailable:"))
+        {
+            found.push((kb.saturating_mul(1024), "MemAvailable"));
+        }
+        if let Some(room) = cgroup_room() {
+            found.push((room, "the cgroup's memory.max"));
+        }
+        match found.into_iter().min() {
+            Some((bytes, what)) => Self {
+                bytes: bytes / 5 * 4,
+                source: format!("80 % of {what}; set it with --max-memory"),
+            },
+            None => Self {
+                bytes: u64::MAX,
+                source: "no limit known: no /proc/meminfo; set one with --max-memory".into(),
+            },
+        }
+    }
+}
+
+/// A `Key:   123 kB` line of /proc/meminfo, in kB.
+fn meminfo_kb(text: &str, key: &str) -> Option<u64> {
+    text.lines()
+        .find_map(|l| l.strip_prefix(key))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|v| v.parse().ok())
+}
+
+/// What the process's cgroup (v2) still allows, if it sets a limit.
+fn cgroup_room() -> Option<u64> {
+    let own = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    let path = own.lines().find_map(|l| l.strip_prefix("0::"))?;
+    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
+    let read = |name: &str| -> Option<u64> {
+        std::fs::read_to_string(dir.join(name))
+            .ok()?
+            .trim()
+            .parse()
+            .ok()
+    };
+    // "max" (no limit) does not parse
+    let max = read("memory.max")?;
+    Some(max.saturating_sub(read("memory.current").unwrap_or(0)))
+}
+
+/// The line stated before any work: what the replay needs, the limit, where the table goes.
+fn memory_statement(memory: &MemoryPlan, limit: &MemoryLimit) -> String {
+    let n = &memory.needs;
+    let limit_text = if limit.bytes == u64::MAX {
+        format!("no limit ({})", limit.source)
+    } else {
+        format!("limit {} ({})", human_bytes(limit.bytes), limit.source)
+    };
+    let parts = format!(
+        "table {} ({} rows × {} B), particles {}, pairing {}, buffers {}",
+        human_bytes(n.table_bytes),
+        n.rows,
+        replay::memory::ROW_BYTES,
+        human_bytes(n.particle_bytes),
+        if n.pairing_bytes == 0 {
+            "stored".to_string()
+        } else {
+            human_bytes(n.pairing_bytes)
+        },
+        human_bytes(n.buffer_bytes)
+    );
+    let slower = n.rows as f64 / STREAM_DECODE_ROWS_PER_SECOND;
+    match memory.reason {
+        ModeReason::Fits => format!(
+            "memory        needs {} with the table in memory ({parts}); {limit_text}",
+            human_bytes(n.in_memory())
+        ),
+        ModeReason::TooLarge => format!(
+            "memory        table {} (whole replay {}) > {limit_text}: streaming from disk, \
+             ~{slower:.2} s per period slower; needs {} ({parts})",
+            human_bytes(n.table_bytes),
+            human_bytes(n.in_memory()),
+            human_bytes(n.streamed())
+        ),
+        ModeReason::Requested => format!(
+            "memory        --stream: the table is read from disk every period, ~{slower:.2} s \
+             per period slower; needs {} ({parts}); {limit_text}",
+            human_bytes(n.streamed())
+        ),
+    }
+}
+
+/// `memory` in `tdex extrapolate --json` (keys in docs/user-guide.md).
+#[derive(Debug, Serialize)]
+struct MemoryReport {
+    /// `null` when no limit is known.
+    limit_bytes: Option<u64>,
+    limit_source: String,
+    /// `in_memory` or `streamed`, and why: `fits`, `too_large`, `requested`.
+    table: &'static str,
+    reason: &'static str,
+    needed_bytes: u64,
+    in_memory_bytes: u64,
+    streamed_bytes: u64,
+    table_bytes: u64,
+    particle_bytes: u64,
+    pairing_bytes: u64,
+    buffer_bytes: u64,
+}
+
+impl MemoryReport {
+    fn of(memory: &MemoryPlan, limit: &MemoryLimit) -> Self {
+        let n = &memory.needs;
+        Self {
+            limit_bytes: (limit.bytes != u64::MAX).then_some(limit.bytes),
+            limit_source: limit.source.clone(),
+            table: match memory.mode {
+                TableMode::InMemory => "in_memory",
+                TableMode::Streamed => "streamed",
+            },
+            reason: match memory.reason {
+                ModeReason::Fits => "fits",
+                ModeReason::TooLarge => "too_large",
+                ModeReason::Requested => "requested",
+            },
+            needed_bytes: memory.needed(),
+            in_memory_bytes: n.in_memory(),
+            streamed_bytes: n.streamed(),
+            table_bytes: n.table_bytes,
+            particle_bytes: n.particle_bytes,
+            pairing_bytes: n.pairing_bytes,
+            buffer_bytes: n.buffer_bytes,
+        }
+    }
 }
 
 fn print(report: &ExtrapolationReport, json: bool) -> Result<()> {

@@ -32,6 +32,13 @@ fn with_workers<R: Send>(
 }
 
 fn main() -> ExitCode {
+    // Under a file-size limit (`ulimit -f`) the kernel kills a process whose write passes it
+    // (SIGXFSZ), leaving its temporary file behind; ignored, the write fails with EFBIG
+    // instead, which tdex reports in plain words after removing the temporary file.
+    // SAFETY: setting a signal's disposition to SIG_IGN before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     let args = cli::Cli::parse_args();
     let result = cli::Plan::from_args(args).and_then(|plan| match plan {
         cli::Plan::Run(p) => run::run(&p),

@@ -97,14 +97,13 @@ pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<St
     (stored.snapshots_fingerprint == fingerprint(t0, t1) && permutation).then_some(stored)
 }
 
-/// Writes the pairing beside the recording (temporary file, then rename).
+/// Writes the pairing beside the recording (temporary file, fsync, rename).
 pub fn store(reader: &RecordingReader, stored: &StoredPairing) -> Result<PathBuf> {
     let path = sidecar(reader.path());
-    let partial = path.with_extension("json.partial");
-    std::fs::write(&partial, serde_json::to_vec(stored)?)
-        .and_then(|_| std::fs::rename(&partial, &path))
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(path)
+    Ok(recorder::output::write_atomically(
+        &path,
+        &serde_json::to_vec(stored)?,
+    )?)
 }
 
 pub fn run(plan: &PairPlan) -> Result<()> {

@@ -5,7 +5,8 @@
 //! force law or pair kind), [`wall`], [`heat`] (conduction), [`integrate`], tied together by
 //! [`pipeline`]; [`counters`] times each stage. [`simulation`] drives a whole drum case.
 //! [`record`] samples the contacts into the table that [`format`] writes; [`import`] builds
-//! the same recording from LIGGGHTS dumps and [`export`] writes files for ParaView.
+//! the same recording from LIGGGHTS dumps and [`export`] writes files for ParaView; every
+//! file goes through [`output`] (temporary file, fsync, rename).
 
 pub mod case;
 pub mod contact;
@@ -18,6 +19,7 @@ pub mod insertion;
 pub mod integrate;
 pub mod math;
 pub mod neighbor;
+pub mod output;
 pub mod particles;
 pub mod pipeline;
 pub mod record;

@@ -29,13 +29,14 @@ pub fn run(plan: &BenchPlan, dir: Option<&Path>) -> Result<PeerRate> {
         Some(d) => d.to_path_buf(),
         None => std::env::temp_dir().join(format!("tdex-bench-liggghts-{}", std::process::id())),
     };
-    std::fs::create_dir_all(&dir)
-        .with_context(|| format!("cannot create the LIGGGHTS directory {}", dir.display()))?;
+    recorder::output::create_dir_all(&dir)?;
     write_deck(&plan.case, &plan.case_path, plan.steps, &dir)?;
     let bar = crate::progress::spinner(
         plan.json,
         &format!("LIGGGHTS 3.8, 1 process, in {}", dir.display()),
     );
+    // LIGGGHTS's console log, written as it runs (like its own log.liggghts): a diagnostic
+    // for a failed run, not an output, so it is not written atomically
     let screen = std::fs::File::create(dir.join("screen.txt"))
         .with_context(|| format!("cannot write {}", dir.join("screen.txt").display()))?;
     let status = Command::new("liggghts")
@@ -133,8 +134,7 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
     };
     for (file, mantle, caps) in meshes {
         let path = dir.join(file);
-        std::fs::write(&path, drum_stl(r, l, mantle, caps))
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        recorder::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
     }
     let axis = t.split_axis.index();
     let ext = if axis == 1 { l / 2.0 + 0.01 } else { r + 0.01 };
@@ -242,7 +242,8 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
     }
     deck.push_str(rest);
     let path = dir.join("in.drum");
-    std::fs::write(&path, deck).with_context(|| format!("cannot write {}", path.display()))
+    recorder::output::write_atomically(&path, deck.as_bytes())?;
+    Ok(())
 }
 
 /// An ASCII STL of the drum (axis y through the origin): the mantle and/or the end caps.

@@ -93,6 +93,11 @@ pub enum Command {
         /// Read the table from the file every period instead of keeping it in memory.
         #[arg(long)]
         stream: bool,
+        /// Memory the extrapolation may use, e.g. 512M, 4G (K, M, G, T: powers of 1024); a
+        /// table that does not fit is streamed from the file. Default: 80 % of MemAvailable
+        /// (and of what the cgroup still allows).
+        #[arg(long = "max-memory", value_name = "SIZE")]
+        max_memory: Option<String>,
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,

@@ -133,6 +133,8 @@ pub struct ExtrapolatePlan {
     pub output: PathBuf,
     pub scheme: Scheme,
     pub stream: bool,
+    /// `--max-memory` in bytes; `None`: a share of the memory available when it starts.
+    pub max_memory: Option<u64>,
     pub threads: usize,
     pub json: bool,
 }
@@ -290,10 +292,14 @@ impl Plan {
                 output,
                 scheme,
                 stream,
+                max_memory,
                 threads: t,
                 json,
             } => {
                 let threads = threads(t)?;
+                let max_memory = max_memory
+                    .map(|m| parse_size(&m).map_err(|e| usage(format!("--max-memory {m}: {e}"))))
+                    .transpose()?;
                 if periods == 0 {
                     return Err(usage(
                         "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
@@ -309,6 +315,7 @@ impl Plan {
                     output,
                     scheme,
                     stream,
+                    max_memory,
                     threads,
                     json,
                 }))
@@ -561,6 +568,35 @@ fn check_parent(output: &std::path::Path) -> Result<()> {
         )));
     }
     Ok(())
+}
+
+/// A size such as `512M`, `4G`, `1.5G`, `100K` or `1048576` (bytes): K, M, G, T are powers
+/// of 1024, an optional `B` or `iB` may follow; at least 1 MiB.
+pub(crate) fn parse_size(text: &str) -> std::result::Result<u64, String> {
+    let t = text.trim();
+    let lower = t.to_ascii_lowercase();
+    let lower = lower
+        .strip_suffix("ib")
+        .or_else(|| lower.strip_suffix('b'))
+        .unwrap_or(&lower);
+    let (number, shift) = match lower.chars().last() {
+        Some('k') => (&lower[..lower.len() - 1], 10),
+        Some('m') => (&lower[..lower.len() - 1], 20),
+        Some('g') => (&lower[..lower.len() - 1], 30),
+        Some('t') => (&lower[..lower.len() - 1], 40),
+        _ => (lower, 0),
+    };
+    let allowed =
+        "give a size such as 512M, 4G or 1.5G (K, M, G, T: powers of 1024; a bare number is bytes)";
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("not a size; {allowed}"))?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes.is_finite() && bytes >= (1u64 << 20) as f64 && bytes < u64::MAX as f64) {
+        return Err(format!("too small or too large: at least 1M; {allowed}"));
+    }
+    Ok(bytes as u64)
 }
 
 fn check_cells(cells: usize) -> Result<()> {

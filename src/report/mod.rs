@@ -13,10 +13,11 @@ use anyhow::{Context, Result};
 use content::{DURATIONS_SVG, ERRORS_SVG, FIELD_SVG, MEANS_SVG, SPEEDUP_SVG};
 use costs::CostTable;
 use recorder::format::{ExtrapolationReader, RecordingReader};
-use std::io::Write;
+use recorder::output::OutputSet;
 use std::path::{Path, PathBuf};
 
-/// The report's own files; older copies are removed before a new report is written.
+/// The report's own files; those of an older report that this one does not write again are
+/// removed once the new report is in place.
 const MARKDOWN: &str = "report.md";
 const HTML: &str = "report.html";
 const ALL_FILES: [&str; 7] = [
@@ -40,28 +41,16 @@ pub fn run(plan: &ReportPlan) -> Result<()> {
     Ok(())
 }
 
-/// Writes the report into `dir` (created if missing); returns the files written. Each file
-/// goes to a temporary name and is renamed into place; the plots come first and the two
-/// reports last, so an interrupted run leaves no report that looks complete.
+/// Writes the report into `dir` (created if missing); returns the files written. Every file
+/// is written and fsynced to a temporary name first and renamed into place only when all
+/// are (plots first, the two reports last): a full disk leaves the previous report whole.
 pub fn write(
     dir: &Path,
     recording: &RecordingReader,
     extrapolation: &ExtrapolationReader,
     comparison: &Comparison,
 ) -> Result<Vec<PathBuf>> {
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("{}: cannot create the report directory", dir.display()))?;
-    for name in ALL_FILES {
-        let path = dir.join(name);
-        match std::fs::remove_file(&path) {
-            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
-                return Err(e).with_context(|| {
-                    format!("{}: cannot remove the previous report file", path.display())
-                })
-            }
-            _ => {}
-        }
-    }
+    recorder::output::create_dir_all(dir)?;
     let info = recording.info();
     let rec_path = recording.path().display().to_string();
 
@@ -156,25 +145,27 @@ pub fn write(
         plots: svgs.iter().map(|(name, _)| *name).collect(),
     });
 
-    let mut written = Vec::new();
+    let mut set = OutputSet::new();
     for (name, svg) in &svgs {
-        written.push(write_atomically(dir, name, svg.as_bytes())?);
+        set.add(&dir.join(name), svg.as_bytes())?;
     }
-    written.push(write_atomically(dir, MARKDOWN, doc.markdown().as_bytes())?);
-    written.push(write_atomically(dir, HTML, doc.html().as_bytes())?);
+    set.add(&dir.join(MARKDOWN), doc.markdown().as_bytes())?;
+    set.add(&dir.join(HTML), doc.html().as_bytes())?;
+    let written = set.commit()?;
+    // a plot of an older report that this one has not (say, no costs this time) would
+    // contradict it: it goes, now that the new report is in place
+    for name in ALL_FILES {
+        let path = dir.join(name);
+        if !written.contains(&path) {
+            match std::fs::remove_file(&path) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                    return Err(e).with_context(|| {
+                        format!("{}: cannot remove the older report's file", path.display())
+                    })
+                }
+                _ => {}
+            }
+        }
+    }
     Ok(written)
-}
-
-/// Writes `dir/name` through a temporary file in `dir` renamed into place.
-pub(crate) fn write_atomically(dir: &Path, name: &str, bytes: &[u8]) -> Result<PathBuf> {
-    let dest = dir.join(name);
-    let partial = dir.join(format!(".{name}.partial-{}", std::process::id()));
-    let result = std::fs::File::create(&partial)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_all()))
-        .and_then(|()| std::fs::rename(&partial, &dest));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&partial);
-        return Err(e).with_context(|| format!("{}: cannot write", dest.display()));
-    }
-    Ok(dest)
 }

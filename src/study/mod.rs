@@ -11,7 +11,7 @@ mod sampling;
 use crate::cli::{ExtrapolatePlan, StudyKind, StudyPlan};
 use crate::compare::{self, Comparison};
 use crate::extrapolation;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use extrapolate::replay::Scheme;
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
@@ -20,8 +20,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 
 pub fn run(plan: &StudyPlan) -> Result<()> {
-    std::fs::create_dir_all(&plan.output)
-        .with_context(|| format!("cannot create {}", plan.output.display()))?;
+    recorder::output::create_dir_all(&plan.output)?;
     match &plan.kind {
         StudyKind::Sampling {
             runs,
@@ -105,6 +104,7 @@ pub fn evaluate(
         output: extra.to_path_buf(),
         scheme: Scheme::Explicit,
         stream: false,
+        max_memory: None,
         threads,
         json: true,
     };
@@ -194,7 +194,10 @@ pub(crate) fn finish(
 
 /// Writes `dir/name` (through a temporary file renamed into place); returns its path.
 pub(crate) fn write_file(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
-    crate::report::write_atomically(dir, name, text.as_bytes())
+    Ok(recorder::output::write_atomically(
+        &dir.join(name),
+        text.as_bytes(),
+    )?)
 }
 
 /// The paths of one run's files in the study directory.

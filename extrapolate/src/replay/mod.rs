@@ -2,9 +2,11 @@
 //! Algorithm 3): temperatures live per role, move to their new roles at each period
 //! boundary, and every row exchanges heat between its two bodies.
 
+pub mod memory;
 mod schemes;
 mod table;
 
+pub use memory::{MemoryNeeds, MemoryPlan, ModeReason, TableMode};
 pub use schemes::{apply_rows, apply_rows_with, Scheme, SyncScratch};
 pub use table::{scan, Bodies, CflRow, Exchange, Table, TableScan};
 
@@ -25,6 +27,26 @@ pub enum ReplayError {
     },
     #[error("pairing of {got} roles for {expected} particles")]
     Roles { got: usize, expected: usize },
+    #[error(
+        "not enough memory: even with the table streamed from the file, {particles} particles need {} \
+         (per-particle state {}, pairing {}, buffers {}), more than the limit of {} ({limit_source}); \
+         allow more with --max-memory (at least {}) or free memory",
+        memory::human_bytes(*needed),
+        memory::human_bytes(*particle_bytes),
+        if *pairing_bytes == 0 { "stored".to_string() } else { memory::human_bytes(*pairing_bytes) },
+        memory::human_bytes(*buffer_bytes),
+        memory::human_bytes(*limit),
+        memory::human_bytes(*needed)
+    )]
+    Memory {
+        particles: u64,
+        needed: u64,
+        particle_bytes: u64,
+        pairing_bytes: u64,
+        buffer_bytes: u64,
+        limit: u64,
+        limit_source: String,
+    },
 }
 
 impl CflRow {

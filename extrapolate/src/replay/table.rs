@@ -143,7 +143,10 @@ impl Table {
         reader: &RecordingReader,
         bodies: &Bodies,
     ) -> Result<(Self, Option<CflRow>), FormatError> {
+        // sized once from the recording (the memory estimate counts rows × 24 B, not the
+        // up to twice as much of a growing Vec); unreserved if that much cannot be had
         let mut exchanges = Vec::new();
+        let _ = exchanges.try_reserve_exact(usize::try_from(reader.table_rows()).unwrap_or(0));
         let found = scan(reader, bodies, |_, e| exchanges.push(e))?;
         Ok((Self { exchanges }, found.worst))
     }

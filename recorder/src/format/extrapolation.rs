@@ -5,7 +5,8 @@
 use super::mcap_file::McapFile;
 use super::proto::POINT_CLOUD_DESCRIPTOR;
 use super::writer::{
-    close_into_place, log_time, open_partial, write_json_metadata, write_message, McapWriter,
+    abandon, close_into_place, log_time, open_partial, write_json_metadata, write_message,
+    McapWriter,
 };
 use super::*;
 use std::collections::BTreeMap;
@@ -44,18 +45,14 @@ pub struct ExtrapolationCosts {
 
 pub struct ExtrapolationWriter {
     mcap: Option<McapWriter>,
-    partial: PathBuf,
     dest: PathBuf,
     channel: u16,
 }
 
 impl ExtrapolationWriter {
     pub fn create(dest: &Path, info: &ExtrapolationInfo) -> Result<Self, FormatError> {
-        let (mut mcap, partial) = open_partial(dest)?;
-        let mcap_err = |error| FormatError::Mcap {
-            path: dest.to_path_buf(),
-            error,
-        };
+        let mut mcap = open_partial(dest)?;
+        let mcap_err = |e| FormatError::writing(dest, e);
         write_json_metadata(&mut mcap, EXTRAPOLATION_METADATA, info).map_err(mcap_err)?;
         let schema = mcap
             .add_schema("foxglove.PointCloud", "protobuf", POINT_CLOUD_DESCRIPTOR)
@@ -65,7 +62,6 @@ impl ExtrapolationWriter {
             .map_err(mcap_err)?;
         Ok(Self {
             mcap: Some(mcap),
-            partial,
             dest: dest.to_path_buf(),
             channel,
         })
@@ -80,21 +76,16 @@ impl ExtrapolationWriter {
             log_time(snapshot.time),
             &snapshot.encode(),
         );
-        result.map_err(|error| FormatError::Mcap {
-            path: self.dest.clone(),
-            error,
-        })
+        result.map_err(|e| FormatError::writing(&self.dest, e))
     }
 
     pub fn finish(mut self, costs: &ExtrapolationCosts) -> Result<(), FormatError> {
         let mut mcap = self.mcap.take().expect("finished once");
-        write_json_metadata(&mut mcap, EXTRAPOLATION_COSTS_METADATA, costs).map_err(|error| {
-            FormatError::Mcap {
-                path: self.dest.clone(),
-                error,
-            }
-        })?;
-        close_into_place(mcap, &self.partial, &self.dest)
+        if let Err(e) = write_json_metadata(&mut mcap, EXTRAPOLATION_COSTS_METADATA, costs) {
+            abandon(mcap);
+            return Err(FormatError::writing(&self.dest, e));
+        }
+        close_into_place(mcap, &self.dest)
     }
 }
 
@@ -102,8 +93,7 @@ impl Drop for ExtrapolationWriter {
     /// An unfinished file is removed, never left looking complete.
     fn drop(&mut self) {
         if let Some(mcap) = self.mcap.take() {
-            drop(mcap);
-            let _ = std::fs::remove_file(&self.partial);
+            abandon(mcap);
         }
     }
 }

@@ -147,6 +147,7 @@ pub enum FormatError {
         path: PathBuf,
         error: std::io::Error,
     },
+    /// An I/O error outside [`crate::output`] (outputs report [`FormatError::Output`]).
     #[error("{path}: cannot write: {error}")]
     Write {
         path: PathBuf,
@@ -170,11 +171,31 @@ pub enum FormatError {
         path: PathBuf,
         error: mcap::McapError,
     },
+    /// Writing an output failed (disk full, permission, ...): the reason in plain words.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
 }
 
 impl FormatError {
+    /// An error of the MCAP writer on `dest`: an I/O error (disk full, ...) becomes an
+    /// [`FormatError::Output`] that says why in plain words.
+    pub fn writing(dest: &std::path::Path, error: mcap::McapError) -> Self {
+        match error {
+            mcap::McapError::Io(e) => {
+                FormatError::Output(crate::output::OutputError::writing(dest, e))
+            }
+            error => FormatError::Mcap {
+                path: dest.to_path_buf(),
+                error,
+            },
+        }
+    }
+
     /// Whether the error is in a file the user gave (exit code 2), not in writing one.
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, FormatError::Write { .. } | FormatError::Mcap { .. })
+        !matches!(
+            self,
+            FormatError::Write { .. } | FormatError::Mcap { .. } | FormatError::Output(_)
+        )
     }
 }

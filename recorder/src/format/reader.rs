@@ -83,6 +83,29 @@ impl RecordingReader {
             .sum()
     }
 
+    /// The largest uncompressed chunk holding table batches (bytes): what reading the
+    /// table holds in memory at once, besides one decoded batch.
+    pub fn largest_table_chunk(&self) -> u64 {
+        self.file
+            .chunks_of_at(self.collision_channel, None)
+            .map(|ci| ci.uncompressed_size)
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Rows of the table: the summary's count, never more than its batches can hold (the
+    /// bound alone for a recording whose writer was interrupted before its summary).
+    pub fn table_rows(&self) -> u64 {
+        let batches = self.file.summary.stats.as_ref().map(|st| {
+            st.channel_message_counts
+                .get(&self.collision_channel)
+                .copied()
+                .unwrap_or(0)
+        });
+        let most = batches.map_or(u64::MAX, |b| b.saturating_mul(table::BATCH_ROWS as u64));
+        self.run_summary.as_ref().map_or(most, |s| s.rows.min(most))
+    }
+
     fn corrupt(&self, detail: String) -> FormatError {
         self.file.corrupt(detail)
     }

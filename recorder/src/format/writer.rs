@@ -1,13 +1,11 @@
-//! Writes a recording: to a temporary file beside the destination, renamed only by
-//! [`RecordingWriter::finish`], so an interrupted run never leaves a file that looks complete.
+//! Writes a recording: to a temporary file beside the destination ([`crate::output`]), renamed only by [`RecordingWriter::finish`], so an interrupted run never leaves a file that looks complete.
 
 use super::proto::{COLLISION_BATCH_DESCRIPTOR, POINT_CLOUD_DESCRIPTOR};
 use super::table::{self, BATCH_ROWS};
 use super::*;
+use crate::output::AtomicFile;
 use crate::record::CollisionRow;
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 /// Uncompressed chunk size: several batches per chunk, so that zstd finds the rows of a long
@@ -18,7 +16,6 @@ pub struct RecordingWriter {
     mcap: Option<McapWriter>,
     info: RecordingInfo,
     dest: PathBuf,
-    partial: PathBuf,
     snapshot_channel: u16,
     collision_channel: u16,
     pending: Vec<CollisionRow>,
@@ -31,11 +28,8 @@ pub struct RecordingWriter {
 impl RecordingWriter {
     /// Starts a recording at `dest` (written to a hidden partial file until `finish`).
     pub fn create(dest: &Path, info: RecordingInfo) -> Result<Self, FormatError> {
-        let (mut mcap, partial) = open_partial(dest)?;
-        let mcap_err = |error| FormatError::Mcap {
-            path: dest.to_path_buf(),
-            error,
-        };
+        let mut mcap = open_partial(dest)?;
+        let mcap_err = |e| FormatError::writing(dest, e);
         write_json_metadata(&mut mcap, INFO_METADATA, &info).map_err(mcap_err)?;
         let snapshot_schema = mcap
             .add_schema("foxglove.PointCloud", "protobuf", POINT_CLOUD_DESCRIPTOR)
@@ -67,7 +61,6 @@ impl RecordingWriter {
             mcap: Some(mcap),
             info,
             dest: dest.to_path_buf(),
-            partial,
             snapshot_channel,
             collision_channel,
             pending: Vec::with_capacity(BATCH_ROWS),
@@ -79,10 +72,7 @@ impl RecordingWriter {
     }
 
     fn mcap_err(&self, error: mcap::McapError) -> FormatError {
-        FormatError::Mcap {
-            path: self.dest.clone(),
-            error,
-        }
+        FormatError::writing(&self.dest, error)
     }
 
     fn nanos(&self, step: u64) -> u64 {
@@ -150,8 +140,8 @@ impl RecordingWriter {
     }
 
     /// The hidden file the recording is written to until [`Self::finish`].
-    pub fn partial_path(&self) -> &Path {
-        &self.partial
+    pub fn partial_path(&self) -> PathBuf {
+        crate::output::temp_path(&self.dest)
     }
 
     /// Writes the last batch, the summary (with the collision-duration histogram) and the
@@ -171,45 +161,33 @@ impl RecordingWriter {
             snapshots: self.snapshots,
         };
         let mut mcap = self.mcap.take().expect("finished once");
-        let dest = self.dest.clone();
-        let mcap_err = |error| FormatError::Mcap {
-            path: dest.clone(),
-            error,
-        };
-        write_json_metadata(&mut mcap, SUMMARY_METADATA, &summary).map_err(mcap_err)?;
-        if let Some(costs) = costs {
-            write_json_metadata(&mut mcap, COSTS_METADATA, costs).map_err(mcap_err)?;
+        let written =
+            write_json_metadata(&mut mcap, SUMMARY_METADATA, &summary).and_then(|()| match costs {
+                Some(costs) => write_json_metadata(&mut mcap, COSTS_METADATA, costs),
+                None => Ok(()),
+            });
+        if let Err(e) = written {
+            abandon(mcap);
+            return Err(FormatError::writing(&self.dest, e));
         }
-        close_into_place(mcap, &self.partial, &self.dest)?;
+        close_into_place(mcap, &self.dest)?;
         Ok(summary)
     }
 }
 
-/// A zstd-chunked MCAP writer on a hidden partial file beside `dest`.
-pub(crate) fn open_partial(dest: &Path) -> Result<(McapWriter, PathBuf), FormatError> {
-    let name = dest
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "tdex.mcap".into());
-    let partial = dest.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-    let file = File::create(&partial).map_err(|error| FormatError::Write {
-        path: dest.to_path_buf(),
-        error,
-    })?;
-    let mcap = mcap::WriteOptions::new()
+/// A zstd-chunked MCAP writer on the hidden temporary file of `dest` ([`crate::output`]).
+pub(crate) fn open_partial(dest: &Path) -> Result<McapWriter, FormatError> {
+    let file = AtomicFile::create(dest)?;
+    mcap::WriteOptions::new()
         .profile(PROFILE)
         .library(format!("tdex {}", env!("CARGO_PKG_VERSION")))
         .compression(Some(mcap::Compression::Zstd))
         .chunk_size(Some(CHUNK_BYTES))
-        .create(BufWriter::with_capacity(1 << 20, file))
-        .map_err(|error| FormatError::Mcap {
-            path: dest.to_path_buf(),
-            error,
-        })?;
-    Ok((mcap, partial))
+        .create(file)
+        .map_err(|e| FormatError::writing(dest, e))
 }
 
-pub(crate) type McapWriter = mcap::Writer<BufWriter<File>>;
+pub(crate) type McapWriter = mcap::Writer<AtomicFile>;
 
 /// MCAP log (and publish) time of a simulated instant: nanoseconds of simulated time.
 pub(crate) fn log_time(seconds: f64) -> u64 {
@@ -246,35 +224,27 @@ pub(crate) fn write_json_metadata(
     })
 }
 
-/// Ends the MCAP file, syncs it and renames the partial file to `dest`.
-pub(crate) fn close_into_place(
-    mut mcap: McapWriter,
-    partial: &Path,
-    dest: &Path,
-) -> Result<(), FormatError> {
-    let write_err = |error| FormatError::Write {
-        path: dest.to_path_buf(),
-        error,
-    };
-    mcap.finish().map_err(|error| FormatError::Mcap {
-        path: dest.to_path_buf(),
-        error,
-    })?;
-    let file = mcap
-        .into_inner()
-        .into_inner()
-        .map_err(|e| write_err(e.into_error()))?;
-    file.sync_all().map_err(write_err)?;
-    std::fs::rename(partial, dest).map_err(write_err)
+/// Ends the MCAP file, fsyncs it, renames it to `dest` and fsyncs the directory.
+pub(crate) fn close_into_place(mut mcap: McapWriter, dest: &Path) -> Result<(), FormatError> {
+    if let Err(e) = mcap.finish() {
+        abandon(mcap);
+        return Err(FormatError::writing(dest, e));
+    }
+    mcap.into_inner().commit()?;
+    Ok(())
+}
+
+/// Drops an unfinished writer without finishing the MCAP file: its temporary file is removed.
+pub(crate) fn abandon(mcap: McapWriter) {
+    // into_inner() marks the writer finished, so its own Drop writes nothing more
+    drop(mcap.into_inner());
 }
 
 impl Drop for RecordingWriter {
     /// An unfinished recording is removed, never left looking complete.
     fn drop(&mut self) {
         if let Some(mcap) = self.mcap.take() {
-            // the mcap writer finishes itself on drop; the partial file goes anyway
-            drop(mcap);
-            let _ = std::fs::remove_file(&self.partial);
+            abandon(mcap);
         }
     }
 }

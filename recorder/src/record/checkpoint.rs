@@ -131,11 +131,8 @@ pub enum CheckpointError {
         path: PathBuf,
         error: std::io::Error,
     },
-    #[error("{}: cannot write the checkpoint: {error}", path.display())]
-    Write {
-        path: PathBuf,
-        error: std::io::Error,
-    },
+    #[error("checkpoint {0}")]
+    Write(#[from] crate::output::OutputError),
     #[error("{}: not a tdex checkpoint (its first line does not start with '{HEADER_PREFIX}')", path.display())]
     NotCheckpoint { path: PathBuf },
     #[error("{}: checkpoint format v{found}; this tdex reads v{CHECKPOINT_VERSION}", path.display())]
@@ -151,7 +148,7 @@ pub enum CheckpointError {
 impl CheckpointError {
     /// Whether the error is in the file the user gave (exit code 2), not in writing one.
     pub fn is_bad_input(&self) -> bool {
-        !matches!(self, CheckpointError::Write { .. })
+        !matches!(self, CheckpointError::Write(_))
     }
 }
 
@@ -160,45 +157,20 @@ impl Checkpoint<'_> {
     /// renamed over the previous checkpoint, and the directory synced. `header` is the text
     /// after the version on the first line.
     pub fn write(&self, path: &Path, header: &str) -> Result<(), CheckpointError> {
-        let write_err = |error| CheckpointError::Write {
-            path: path.to_path_buf(),
-            error,
-        };
-        let body = postcard::to_stdvec(self).map_err(|e| write_err(std::io::Error::other(e)))?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_else(|| "tdex.checkpoint".into());
-        let partial = path.with_file_name(format!(".{name}.partial-{}", std::process::id()));
-        let written = (|| -> std::io::Result<()> {
-            let mut file = std::fs::File::create(&partial)?;
+        let body = postcard::to_stdvec(self)
+            .map_err(|e| crate::output::OutputError::writing(path, std::io::Error::other(e)))?;
+        crate::output::write_with(path, |file| {
             let line = format!(
                 "{HEADER_PREFIX}{CHECKPOINT_VERSION}: {}\n",
                 header.replace('\n', " ")
             );
-            let mut head = line.into_bytes();
-            head.extend_from_slice(&(body.len() as u64).to_le_bytes());
-            head.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
-            file.write_all(&head)?;
-            file.write_all(&body)?;
-            file.sync_all()?;
-            std::fs::rename(&partial, path)?;
-            sync_dir(path)
-        })();
-        if written.is_err() {
-            let _ = std::fs::remove_file(&partial);
-        }
-        written.map_err(write_err)
+            file.write_all(line.as_bytes())?;
+            file.write_all(&(body.len() as u64).to_le_bytes())?;
+            file.write_all(&crc32fast::hash(&body).to_le_bytes())?;
+            file.write_all(&body)
+        })?;
+        Ok(())
     }
-}
-
-/// Syncs the directory holding `path`, so that a rename in it survives a crash.
-pub(crate) fn sync_dir(path: &Path) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    std::fs::File::open(dir)?.sync_all()
 }
 
 impl Checkpoint<'static> {

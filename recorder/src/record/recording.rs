@@ -170,8 +170,38 @@ pub fn resume(
     };
     check(&options)?;
     let restored = checkpoint.restore(&case, path)?;
+    // temporary files of the killed run (its output, a checkpoint it was writing)
+    remove_stale_temps(&dest);
+    remove_stale_temps(path);
     let saver = Saver::new(&run, path, run.checkpoint_every.expect("set above"))?;
     drive(&run, Some(saver), Some(restored), progress)
+}
+
+/// Removes the hidden temporary files of `dest` left by processes that no longer run (a
+/// killed recording); on systems without `/proc` it leaves them.
+fn remove_stale_temps(dest: &Path) {
+    let (Some(dir), Some(name)) = (dest.parent(), dest.file_name()) else {
+        return;
+    };
+    let prefix = format!(".{}.partial-", name.to_string_lossy());
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let pid = file
+            .to_string_lossy()
+            .strip_prefix(&prefix)
+            .map(str::to_owned);
+        if let Some(pid) = pid.filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit())) {
+            if pid != std::process::id().to_string() && !Path::new("/proc").join(&pid).exists() {
+                let _ = std::fs::remove_file(entry.path());
+            }
+        }
+    }
 }
 
 fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
@@ -233,9 +263,8 @@ impl Saver {
                 ))
             })?;
         let absolute = |p: &Path| {
-            std::path::absolute(p).map_err(|error| CheckpointError::Write {
-                path: p.to_path_buf(),
-                error,
+            std::path::absolute(p).map_err(|error| {
+                CheckpointError::from(crate::output::OutputError::writing(p, error))
             })
         };
         Ok(Self {
@@ -447,7 +476,7 @@ fn drive(
     if let Stage::Period { done } = stage {
         let began = Instant::now();
         let (period_base, recorder_base) = (elapsed.period, elapsed.recorder);
-        let partial = sink.writer.partial_path().to_path_buf();
+        let partial = sink.writer.partial_path();
         let mut hook = PeriodSaver {
             run,
             saver: saver.as_mut(),
@@ -496,7 +525,7 @@ fn drive(
         for period in first..opts.reference_periods {
             let start = if period == first { done } else { 0 };
             let offset = period as u64 * opts.period_steps;
-            let partial = sink.writer.partial_path().to_path_buf();
+            let partial = sink.writer.partial_path();
             run_phase(
                 &mut sim,
                 start,
