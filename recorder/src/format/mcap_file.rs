@@ -8,10 +8,27 @@ use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8] = b"\x89MCAP0\r\n";
 
+/// The bytes of an MCAP file: memory-mapped from disk, or handed over in memory.
+pub(crate) enum Bytes {
+    Mapped(Mmap),
+    Owned(Vec<u8>),
+}
+
+impl std::ops::Deref for Bytes {
+    type Target = [u8];
+
+    fn deref(&self) -> &[u8] {
+        match self {
+            Bytes::Mapped(m) => m,
+            Bytes::Owned(v) => v,
+        }
+    }
+}
+
 /// An MCAP file opened for reading; `what` names the kind of tdex file for error messages.
 pub(crate) struct McapFile {
     pub(crate) path: PathBuf,
-    pub(crate) bytes: Mmap,
+    pub(crate) bytes: Bytes,
     pub(crate) summary: mcap::Summary,
     what: &'static str,
 }
@@ -30,6 +47,16 @@ impl McapFile {
             path: path_buf.clone(),
             error,
         })?;
+        Self::from_bytes(path, Bytes::Mapped(bytes), what)
+    }
+
+    /// Checks the bytes of the file `path` (named in messages) as [`McapFile::open`] does.
+    pub(crate) fn from_bytes(
+        path: &Path,
+        bytes: Bytes,
+        what: &'static str,
+    ) -> Result<Self, FormatError> {
+        let path_buf = path.to_path_buf();
         if !bytes.starts_with(MAGIC) {
             return Err(FormatError::NotMcap { path: path_buf });
         }
