@@ -12,6 +12,7 @@ pub mod contact;
 pub mod counters;
 pub mod export;
 pub mod format;
+pub mod fuzzing;
 pub mod heat;
 pub mod import;
 pub mod insertion;
