@@ -152,6 +152,11 @@ impl ExtrapolationReader {
                 info.format_version
             )));
         }
+        info.recording_info.check().map_err(|e| {
+            file.corrupt(format!(
+                "metadata '{EXTRAPOLATION_METADATA}': recording_info: {e}"
+            ))
+        })?;
         let costs = file.metadata(EXTRAPOLATION_COSTS_METADATA)?;
         let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;
         Ok(Self {

@@ -51,6 +51,8 @@ impl RecordingReader {
                 info.format_version
             )));
         }
+        info.check()
+            .map_err(|e| file.corrupt(format!("metadata '{INFO_METADATA}': {e}")))?;
         let run_summary = file.metadata(SUMMARY_METADATA)?;
         let costs = file.metadata(COSTS_METADATA)?;
         let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;

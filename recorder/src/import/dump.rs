@@ -106,6 +106,9 @@ fn matches(pattern: &[char], name: &[char]) -> bool {
     }
 }
 
+/// The largest timestep LIGGGHTS writes (a signed 64-bit `bigint`).
+pub const MAX_TIMESTEP: u64 = i64::MAX as u64;
+
 /// The first two bytes of a gzip file.
 const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
 
@@ -227,15 +230,21 @@ impl FrameReader {
             ));
         }
         let value = self.expect_line("the timestep")?;
-        let step = value.trim().parse::<u64>().map_err(|_| {
-            self.error(
-                self.line,
-                format!(
-                    "timestep `{}` is not a whole number ≥ 0",
-                    shorten(value.trim())
-                ),
-            )
-        })?;
+        let step = value
+            .trim()
+            .parse::<u64>()
+            .ok()
+            .filter(|&s| s <= MAX_TIMESTEP)
+            .ok_or_else(|| {
+                self.error(
+                    self.line,
+                    format!(
+                        "timestep `{}` is not a whole number in 0..={MAX_TIMESTEP} (LIGGGHTS' \
+                         64-bit signed timestep)",
+                        shorten(value.trim())
+                    ),
+                )
+            })?;
         Ok(Some((step, line)))
     }
 

@@ -111,6 +111,7 @@ pub fn import(
         ),
     };
     let (step_t0, every) = (atoms.step_t0, opts.sample_every as u64);
+    // no overflow: the atom dumps hold t1 = t0 + τ, a timestep ≤ dump::MAX_TIMESTEP
     let step_t1 = step_t0 + opts.period_steps;
     let mut set = DumpSet::open(&dumps.contacts, Items::Entries)?;
     let (mut sampled, mut skipped) = (0u64, 0u64);
@@ -248,7 +249,7 @@ fn snapshots_of(
              atom dump, + τ = {period} steps); other atom timesteps found: {}. Dump the atoms \
              at t0 and every τ steps after it (or give --tau / --tau-rev for the period that \
              was dumped)",
-            step_t0 + period,
+            step_t0.saturating_add(period),
             if others.is_empty() {
                 "none".to_string()
             } else {
