@@ -135,9 +135,25 @@ impl McapFile {
         if end.is_none_or(|e| e > self.bytes.len() as u64) || index.length < 9 {
             return Err(self.corrupt(format!("metadata index '{name}' points outside the file")));
         }
-        let record = mcap::read::metadata(&self.bytes, index)
-            .map_err(|e| self.corrupt(format!("metadata '{name}': {e}")))?;
-        record
+        // parsed here: the mcap crate's `read::metadata` runs its linear reader over the
+        // indexed bytes, which enters a chunk record found there (see
+        // `check_summary_section`)
+        let record = &self.bytes[index.offset as usize..(index.offset + index.length) as usize];
+        let body_length = u64::from_le_bytes(record[1..9].try_into().expect("8 bytes"));
+        if record[0] != mcap::records::op::METADATA || body_length != index.length - 9 {
+            return Err(self.corrupt(format!(
+                "metadata index '{name}' points at a record of opcode {:#04x} and length {body_length}, \
+                 not a metadata record of {} bytes",
+                record[0],
+                index.length - 9
+            )));
+        }
+        let metadata = match mcap::parse_record(mcap::records::op::METADATA, &record[9..]) {
+            Ok(mcap::records::Record::Metadata(m)) => m,
+            Ok(_) => return Err(self.corrupt(format!("metadata '{name}': not a metadata record"))),
+            Err(e) => return Err(self.corrupt(format!("metadata '{name}': {e}"))),
+        };
+        metadata
             .metadata
             .get("json")
             .cloned()
@@ -320,8 +336,14 @@ fn check_summary_section(bytes: &[u8]) -> Result<(), String> {
     const FOOTER_LENGTH: usize = 1 + 8 + 20;
     let footer = bytes.len() - MAGIC.len() - FOOTER_LENGTH;
     let u64_at = |at: usize| u64::from_le_bytes(bytes[at..at + 8].try_into().expect("8 bytes"));
-    if bytes[footer] != op::FOOTER || u64_at(footer + 1) != 20 {
+    if bytes[footer] != op::FOOTER {
         return Ok(()); // no footer: the mcap crate says so
+    }
+    if u64_at(footer + 1) != 20 {
+        return Err(format!(
+            "the footer's record length is {} (it must be 20)",
+            u64_at(footer + 1)
+        ));
     }
     let start = u64_at(footer + 9);
     if start == 0 {
