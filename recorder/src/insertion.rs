@@ -58,7 +58,11 @@ pub fn lattice_site_count(radius: f64, drum_radius: f64, drum_length: f64, limit
     let mut total: u128 = 0;
     for step in 0..=nr.saturating_mul(2) {
         // rows iz = 0, 1, -1, 2, -2, ...
-        let iz = if step % 2 == 1 { step / 2 + 1 } else { -(step / 2) };
+        let iz = if step % 2 == 1 {
+            step / 2 + 1
+        } else {
+            -(step / 2)
+        };
         if iz.abs() > nr {
             break;
         }

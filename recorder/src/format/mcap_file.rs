@@ -240,7 +240,10 @@ impl McapFile {
         let start = ci.chunk_start_offset as usize;
         let record = &self.bytes[start..start + ci.chunk_length as usize];
         if record[0] != op::CHUNK {
-            return Err(format!("opcode {:#04x} where a chunk was indexed", record[0]));
+            return Err(format!(
+                "opcode {:#04x} where a chunk was indexed",
+                record[0]
+            ));
         }
         let (header, data) = match mcap::parse_record(op::CHUNK, &record[9..]) {
             Ok(Record::Chunk { header, data }) => (header, data),
@@ -358,7 +361,10 @@ fn check_summary_section(bytes: &[u8]) -> Result<(), String> {
     let mut at = start as usize;
     while at < footer {
         if footer - at < 9 {
-            return Err(format!("{} bytes at offset {at} are not a record", footer - at));
+            return Err(format!(
+                "{} bytes at offset {at} are not a record",
+                footer - at
+            ));
         }
         let opcode = bytes[at];
         let length = u64_at(at + 1);

@@ -96,9 +96,7 @@ pub fn decode(bytes: &[u8], info: &RecordingInfo) -> Result<TableBatch, String> 
             ));
         }
         let end = row.start_step.checked_add(row.duration_steps as u64);
-        if end.is_none_or(|end| end > info.period_steps)
-            || row.start_step < previous_start
-        {
+        if end.is_none_or(|end| end > info.period_steps) || row.start_step < previous_start {
             return bad(format!(
                 "start step {} (duration {}) out of apparition order or beyond the period of {} steps",
                 row.start_step, row.duration_steps, info.period_steps
