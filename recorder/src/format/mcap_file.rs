@@ -93,11 +93,14 @@ impl McapFile {
         };
         for ci in &file.summary.chunk_indexes {
             let end = ci.chunk_start_offset.checked_add(ci.chunk_length);
-            if ci.chunk_length < 9 || end.is_none_or(|e| e > file.bytes.len() as u64) {
+            let index_end = end.and_then(|e| e.checked_add(ci.message_index_length));
+            if ci.chunk_length < 9 || index_end.is_none_or(|e| e > file.bytes.len() as u64) {
                 return Err(file.corrupt(format!(
-                    "chunk index at offset {} (length {}) points outside the file of {} bytes",
+                    "chunk index at offset {} (length {}, message indexes {} bytes) points \
+                     outside the file of {} bytes",
                     ci.chunk_start_offset,
                     ci.chunk_length,
+                    ci.message_index_length,
                     file.bytes.len()
                 )));
             }

@@ -94,8 +94,8 @@ impl RecordingReader {
     pub fn table_bytes(&self) -> u64 {
         self.file
             .chunks_of_at(self.collision_channel, None)
-            .map(|ci| ci.chunk_length + ci.message_index_length)
-            .sum()
+            .map(|ci| ci.chunk_length.saturating_add(ci.message_index_length))
+            .fold(0, u64::saturating_add)
     }
 
     fn corrupt(&self, detail: String) -> FormatError {
