@@ -28,3 +28,17 @@ for log in sorted(glob.glob(os.path.join(here, "logs", "*.log"))):
     rows.append((target, int(tag), seconds, int(execs[-1]) if execs else 0, outcome))
 for target, tag, seconds, execs, outcome in sorted(rows):
     print(f"| {target} | {tag} | {seconds} s ({seconds / 3600:.3f} h) | {execs:,} | {outcome} |")
+print()
+totals = {}
+for target, tag, seconds, execs, outcome in rows:
+    t = totals.setdefault(target, [0, 0, 0, 0])
+    t[0] += 1
+    t[1] += seconds
+    t[2] += execs
+    t[3] += outcome != "no crash"
+for target, (runs, seconds, execs, crashes) in sorted(totals.items()):
+    print(f"| {target} | {runs} | {seconds} s ({seconds / 3600:.2f} h) | {execs:,} | {crashes} |")
+s = sum(t[1] for t in totals.values())
+e = sum(t[2] for t in totals.values())
+c = sum(t[3] for t in totals.values())
+print(f"| all | {sum(t[0] for t in totals.values())} | {s} s ({s / 3600:.2f} h) | {e:,} | {c} |")
