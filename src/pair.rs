@@ -5,36 +5,12 @@ use crate::cli::PairPlan;
 use anyhow::{Context, Result};
 use extrapolate::pairing::{self, PairingOptions};
 use recorder::format::{RecordingReader, Snapshot};
-use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The pairing summary (`tdex pair --json`; keys in docs/user-guide.md).
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct PairingSummary {
-    pub particles: usize,
-    pub diameter: f64,
-    pub total_distance_diameters: f64,
-    pub mean_distance_diameters: f64,
-    pub k_used: usize,
-    pub certified: bool,
-    pub rounds: u32,
-    pub seconds: f64,
-    pub threads: usize,
-}
-
-/// The stored pairing: `g[p]` = the role particle `p` takes in the next period.
-#[derive(Debug, Serialize, Deserialize)]
-pub struct StoredPairing {
-    /// [`fingerprint`] of the snapshots it pairs: reused only for the same positions.
-    pub snapshots_fingerprint: u64,
-    pub summary: PairingSummary,
-    pub g: Vec<u32>,
-}
+pub use extrapolate::sidecar::{PairingSummary, StoredPairing};
 
 pub fn sidecar(recording: &Path) -> PathBuf {
-    let mut name = recording.as_os_str().to_owned();
-    name.push(".pairing.json");
-    PathBuf::from(name)
+    extrapolate::sidecar::path_of(recording)
 }
 
 /// The snapshots at `t0` and `t1` that bound the recorded period.
@@ -81,20 +57,12 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing> {
     })
 }
 
-/// The stored pairing of this recording's snapshots `t0` and `t1`, if one matches them.
+/// The stored pairing of this recording's snapshots `t0` and `t1`, if one matches them (a
+/// missing, unreadable or malformed sidecar is computed again).
 pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<StoredPairing> {
-    let text = std::fs::read_to_string(sidecar(reader.path())).ok()?;
-    let stored: StoredPairing = serde_json::from_str(&text).ok()?;
     let n = reader.info().particles as usize;
-    let permutation = {
-        let mut seen = vec![false; n];
-        stored.g.len() == n
-            && stored
-                .g
-                .iter()
-                .all(|&r| (r as usize) < n && !std::mem::replace(&mut seen[r as usize], true))
-    };
-    (stored.snapshots_fingerprint == fingerprint(t0, t1) && permutation).then_some(stored)
+    let stored = extrapolate::sidecar::read(&sidecar(reader.path()), n).ok()??;
+    (stored.snapshots_fingerprint == fingerprint(t0, t1)).then_some(stored)
 }
 
 /// Writes the pairing beside the recording (temporary file, fsync, rename).

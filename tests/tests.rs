@@ -15,6 +15,7 @@ mod cli_report;
 mod cli_run;
 mod cli_study;
 mod drum;
+mod fuzz_corpus;
 mod physics_collision;
 mod physics_conduction;
 mod record;

@@ -36,9 +36,59 @@ fn lattice_sites(radius: f64, drum_radius: f64, drum_length: f64) -> Vec<[f64; 3
     sites
 }
 
-/// How many particles the insertion lattice can hold.
-pub fn lattice_site_count(radius: f64, drum_radius: f64, drum_length: f64) -> usize {
-    lattice_sites(radius, drum_radius, drum_length).len()
+/// How many particles the insertion lattice can hold, counted up to `limit`: the sites are
+/// counted row by row from the axis outwards without being listed, so a drum millions of
+/// radii wide costs no memory and at most about `sqrt(limit)` rows.
+pub fn lattice_site_count(radius: f64, drum_radius: f64, drum_length: f64, limit: usize) -> usize {
+    let spacing = 2.0 * radius * (1.0 + GAP);
+    let clearance = radius * (1.0 + GAP);
+    let rho_max = drum_radius - clearance;
+    let half_len = 0.5 * drum_length - clearance;
+    if !(rho_max > 0.0 && half_len >= 0.0 && spacing > 0.0) {
+        return 0;
+    }
+    // as in `lattice_sites` (float-to-int casts saturate)
+    let ny = ((2.0 * half_len / spacing).floor() as i64).saturating_add(1) as u128;
+    let nr = (rho_max / spacing).floor() as i64;
+    let inside = |ix: i64, iz: i64| {
+        let (x, z) = (ix as f64 * spacing, iz as f64 * spacing);
+        x * x + z * z <= rho_max * rho_max
+    };
+    let limit = limit as u128;
+    let mut total: u128 = 0;
+    for step in 0..=nr.saturating_mul(2) {
+        // rows iz = 0, 1, -1, 2, -2, ...
+        let iz = if step % 2 == 1 {
+            step / 2 + 1
+        } else {
+            -(step / 2)
+        };
+        if iz.abs() > nr {
+            break;
+        }
+        // the largest ix ≥ 0 inside the row: from the circle, then corrected by the lattice's
+        // own test (rounding moves it by one at most; a bounded loop even if rho² overflows)
+        let z = iz as f64 * spacing;
+        let mut k = ((rho_max * rho_max - z * z).max(0.0).sqrt() / spacing).floor() as i64;
+        k = k.min(nr);
+        for _ in 0..2 {
+            if k < nr && inside(k + 1, iz) {
+                k += 1;
+            }
+        }
+        for _ in 0..3 {
+            if k >= 0 && !inside(k, iz) {
+                k -= 1;
+            }
+        }
+        if k >= 0 {
+            total += (2 * k as u128 + 1) * ny;
+        }
+        if total >= limit {
+            return limit as usize;
+        }
+    }
+    total as usize
 }
 
 /// Uniform in [0, 1) from the top 53 bits.
@@ -88,9 +138,27 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_site_count_is_the_lattice_size_up_to_its_limit() {
+        for (r, rd, l) in [
+            (0.005, 0.05, 0.06),
+            (0.0013, 0.1, 0.02),
+            (0.004, 0.0421, 0.1),
+            (0.01, 0.011, 0.05),
+            (0.01, 0.005, 0.05),
+        ] {
+            let n = lattice_sites(r, rd, l).len();
+            assert_eq!(lattice_site_count(r, rd, l, usize::MAX), n, "{r} {rd} {l}");
+            assert_eq!(lattice_site_count(r, rd, l, n / 2), n / 2);
+        }
+        // a drum 10^12 radii wide: counted to the limit, instantly
+        assert_eq!(lattice_site_count(1e-12, 1.0, 1.0, 1 << 31), 1 << 31);
+        assert_eq!(lattice_site_count(1e-3, 1e300, 1e-2, 1000), 1000);
+    }
+
+    #[test]
     fn inserted_spheres_never_overlap_and_stay_inside() {
         let (r, rd, len) = (0.005, 0.05, 0.06);
-        let n = lattice_site_count(r, rd, len) * 9 / 10;
+        let n = lattice_site_count(r, rd, len, usize::MAX) * 9 / 10;
         let p = insert(n, r, 2500.0, 300.0, rd, len, 3).unwrap();
         assert_eq!(p.len(), n);
         for i in 0..n {
@@ -118,7 +186,7 @@ mod tests {
 
     #[test]
     fn too_many_particles_is_refused() {
-        let n = lattice_site_count(0.005, 0.05, 0.06);
+        let n = lattice_site_count(0.005, 0.05, 0.06, usize::MAX);
         assert!(insert(n + 1, 0.005, 2500.0, 300.0, 0.05, 0.06, 1).is_none());
     }
 }

@@ -13,6 +13,7 @@ pub mod contact;
 pub mod counters;
 pub mod export;
 pub mod format;
+pub mod fuzzing;
 pub mod heat;
 pub mod import;
 pub mod insertion;

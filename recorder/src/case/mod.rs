@@ -35,11 +35,28 @@ pub fn load(path: &Path) -> Result<Case, CaseError> {
 
 /// [`load`], also returning the file's text as given (a recording stores it).
 pub fn load_with_text(path: &Path) -> Result<(Case, String), CaseError> {
-    let text = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+    let bytes = std::fs::read(path).map_err(|source| CaseError::Read {
         path: path.to_path_buf(),
         source,
     })?;
-    Ok((parse(&text, path)?, text))
+    parse_bytes(&bytes, path)
+}
+
+/// [`parse`] of a case file's bytes, which must be UTF-8 text; also returns the text.
+pub fn parse_bytes(bytes: &[u8], path: &Path) -> Result<(Case, String), CaseError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| CaseError::Parse {
+        path: path.to_path_buf(),
+        message: format!(
+            "not UTF-8 text: byte {:#04x} at offset {} (line {}) is not valid UTF-8",
+            bytes[e.valid_up_to()],
+            e.valid_up_to(),
+            1 + bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+        ),
+    })?;
+    Ok((parse(text, path)?, text.to_string()))
 }
 
 /// Parses and validates case text; `path` is only used in messages.

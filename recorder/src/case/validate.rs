@@ -215,7 +215,7 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
             ),
         ));
     }
-    let sites = insertion::lattice_site_count(p.radius, d.radius, d.length);
+    let sites = insertion::lattice_site_count(p.radius, d.radius, d.length, p.count);
     if sites < p.count {
         return Err(refuse(
             "particles.count",

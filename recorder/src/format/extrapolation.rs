@@ -2,7 +2,7 @@
 //! conventions (`foxglove.PointCloud` on `/tdex/snapshots`, sequence = snapshot index), its
 //! writer and its reader.
 
-use super::mcap_file::McapFile;
+use super::mcap_file::{Bytes, McapFile};
 use super::proto::POINT_CLOUD_DESCRIPTOR;
 use super::writer::{
     abandon, close_into_place, log_time, open_partial, write_json_metadata, write_message,
@@ -117,7 +117,20 @@ impl std::fmt::Debug for ExtrapolationReader {
 impl ExtrapolationReader {
     /// Opens `path` and checks that it is a complete tdex extrapolation of a known version.
     pub fn open(path: &Path) -> Result<Self, FormatError> {
-        let file = McapFile::open(path, "extrapolation")?;
+        Self::checked(McapFile::open(path, "extrapolation")?)
+    }
+
+    /// [`ExtrapolationReader::open`] on the file's bytes already in memory; `path` names the
+    /// file in messages.
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, FormatError> {
+        Self::checked(McapFile::from_bytes(
+            path,
+            Bytes::Owned(bytes),
+            "extrapolation",
+        )?)
+    }
+
+    fn checked(file: McapFile) -> Result<Self, FormatError> {
         let info: ExtrapolationInfo = file.metadata(EXTRAPOLATION_METADATA)?.ok_or_else(|| {
             file.not_ours(format!(
                 "it has no '{EXTRAPOLATION_METADATA}' metadata record"
@@ -129,6 +142,11 @@ impl ExtrapolationReader {
                 info.format_version
             )));
         }
+        info.recording_info.check().map_err(|e| {
+            file.corrupt(format!(
+                "metadata '{EXTRAPOLATION_METADATA}': recording_info: {e}"
+            ))
+        })?;
         let costs = file.metadata(EXTRAPOLATION_COSTS_METADATA)?;
         let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;
         Ok(Self {

@@ -106,7 +106,92 @@ pub struct RecordingInfo {
 impl RecordingInfo {
     /// Simulated time of the snapshot with this index (0: `t0`, 1: `t1`, k: `t0 + kτ`).
     pub fn snapshot_time(&self, index: u32) -> f64 {
-        (self.step_t0 + index as u64 * self.period_steps) as f64 * self.dt
+        // in f64 (exact below 2^53 steps): a damaged file's step counts cannot overflow
+        (self.step_t0 as f64 + index as f64 * self.period_steps as f64) * self.dt
+    }
+
+    /// Checks the values the readers and the replay rely on; the error names the field, its
+    /// value and what is allowed.
+    pub fn check(&self) -> Result<(), String> {
+        let bad = |field: &str, value: &dyn std::fmt::Display, allowed: &str| {
+            Err(format!("{field} = {value} is not allowed: {allowed}"))
+        };
+        let bodies = self.particles as u64 + self.walls.len() as u64;
+        if self.particles == 0 || bodies > u32::MAX as u64 {
+            return bad(
+                "particles",
+                &self.particles,
+                &format!(
+                    "must be at least 1, and with the {} walls at most {}",
+                    self.walls.len(),
+                    u32::MAX
+                ),
+            );
+        }
+        for (k, w) in self.walls.iter().enumerate() {
+            if w.id as u64 != self.particles as u64 + k as u64 {
+                return bad(
+                    &format!("walls[{k}].id"),
+                    &w.id,
+                    "must be particles + the wall's index",
+                );
+            }
+            if w.temperature.is_some_and(|t| !t.is_finite()) {
+                return bad(
+                    &format!("walls[{k}].temperature"),
+                    &w.temperature.unwrap_or_default(),
+                    "must be a finite number or absent",
+                );
+            }
+        }
+        for (field, value) in [
+            ("sample_every", self.sample_every as u64),
+            ("dtc_max_steps", self.dtc_max_steps as u64),
+            ("period_steps", self.period_steps),
+        ] {
+            if value == 0 {
+                return bad(field, &value, "must be at least 1");
+            }
+        }
+        let last_step = (self.reference_periods as u64 + 1)
+            .checked_mul(self.period_steps)
+            .and_then(|s| s.checked_add(self.step_t0));
+        if last_step.is_none() {
+            return bad(
+                "step_t0",
+                &self.step_t0,
+                &format!(
+                    "with {} reference periods of {} steps, must end before step 2^64",
+                    self.reference_periods, self.period_steps
+                ),
+            );
+        }
+        for (field, value) in [
+            ("dt", self.dt),
+            ("density", self.density),
+            ("heat_capacity", self.heat_capacity),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return bad(field, &value, "must be a finite number > 0");
+            }
+        }
+        for (field, value) in [
+            ("pair_conductivity", self.pair_conductivity),
+            ("wall_conductivity", self.wall_conductivity),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return bad(field, &value, "must be a finite number >= 0");
+            }
+        }
+        let unit = self.sqrt_area_unit;
+        if self.area_encoding == AreaEncoding::Quantized && !(unit.is_finite() && unit > 0.0) {
+            return bad(
+                "sqrt_area_unit",
+                &unit,
+                "must be a finite number > 0 with quantized areas",
+            );
+        }
+        Ok(())
     }
 }
 

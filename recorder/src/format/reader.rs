@@ -1,7 +1,7 @@
 //! Reads a recording without loading it whole: the file is memory-mapped, the summary section
 //! gives the metadata and chunk indexes, and the table is decoded one chunk at a time.
 
-use super::mcap_file::McapFile;
+use super::mcap_file::{Bytes, McapFile};
 use super::table::{self, TableBatch};
 use super::writer::log_time;
 use super::*;
@@ -28,7 +28,20 @@ impl std::fmt::Debug for RecordingReader {
 impl RecordingReader {
     /// Opens `path` and checks that it is a complete tdex recording of a known version.
     pub fn open(path: &Path) -> Result<Self, FormatError> {
-        let file = McapFile::open(path, "recording")?;
+        Self::checked(McapFile::open(path, "recording")?)
+    }
+
+    /// [`RecordingReader::open`] on the file's bytes already in memory; `path` names the
+    /// file in messages.
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> Result<Self, FormatError> {
+        Self::checked(McapFile::from_bytes(
+            path,
+            Bytes::Owned(bytes),
+            "recording",
+        )?)
+    }
+
+    fn checked(file: McapFile) -> Result<Self, FormatError> {
         let info: RecordingInfo = file
             .metadata(INFO_METADATA)?
             .ok_or_else(|| file.not_ours(format!("it has no '{INFO_METADATA}' metadata record")))?;
@@ -38,6 +51,8 @@ impl RecordingReader {
                 info.format_version
             )));
         }
+        info.check()
+            .map_err(|e| file.corrupt(format!("metadata '{INFO_METADATA}': {e}")))?;
         let run_summary = file.metadata(SUMMARY_METADATA)?;
         let costs = file.metadata(COSTS_METADATA)?;
         let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;
@@ -79,8 +94,8 @@ impl RecordingReader {
     pub fn table_bytes(&self) -> u64 {
         self.file
             .chunks_of_at(self.collision_channel, None)
-            .map(|ci| ci.chunk_length + ci.message_index_length)
-            .sum()
+            .map(|ci| ci.chunk_length.saturating_add(ci.message_index_length))
+            .fold(0, u64::saturating_add)
     }
 
     /// The largest uncompressed chunk holding table batches (bytes): what reading the

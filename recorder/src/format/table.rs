@@ -65,7 +65,7 @@ pub fn decode(bytes: &[u8], info: &RecordingInfo) -> Result<TableBatch, String> 
             info.sqrt_area_unit
         ));
     }
-    let bodies = info.particles + info.walls.len() as u32;
+    let bodies = info.particles.saturating_add(info.walls.len() as u32);
     let mut rows = Vec::with_capacity(n);
     let mut previous_start = 0;
     for r in 0..n {
@@ -95,9 +95,8 @@ pub fn decode(bytes: &[u8], info: &RecordingInfo) -> Result<TableBatch, String> 
                 row.duration_steps, info.dtc_max_steps
             ));
         }
-        if row.start_step + row.duration_steps as u64 > info.period_steps
-            || row.start_step < previous_start
-        {
+        let end = row.start_step.checked_add(row.duration_steps as u64);
+        if end.is_none_or(|end| end > info.period_steps) || row.start_step < previous_start {
             return bad(format!(
                 "start step {} (duration {}) out of apparition order or beyond the period of {} steps",
                 row.start_step, row.duration_steps, info.period_steps

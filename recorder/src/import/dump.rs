@@ -106,6 +106,12 @@ fn matches(pattern: &[char], name: &[char]) -> bool {
     }
 }
 
+/// The largest timestep LIGGGHTS writes (a signed 64-bit `bigint`).
+pub const MAX_TIMESTEP: u64 = i64::MAX as u64;
+
+/// The first two bytes of a gzip file.
+const GZIP_MAGIC: [u8; 2] = [0x1f, 0x8b];
+
 /// Frames of one file in order; the next frame's timestep is read ahead so that files can be
 /// merged by timestep.
 struct FrameReader {
@@ -126,16 +132,32 @@ impl FrameReader {
         };
         let mut file = File::open(path).map_err(read_err)?;
         let mut magic = [0u8; 2];
-        let gzip = file.read(&mut magic).map_err(read_err)? == 2 && magic == [0x1f, 0x8b];
+        let gzip = file.read(&mut magic).map_err(read_err)? == 2 && magic == GZIP_MAGIC;
         drop(file);
         let file = File::open(path).map_err(read_err)?;
+        Self::new(path, items, gzip, Box::new(file))
+    }
+
+    /// [`FrameReader::open`] on the file's bytes already in memory; `path` names it in messages.
+    fn from_bytes(path: &Path, items: Items, bytes: Vec<u8>) -> Result<Self, ImportError> {
+        let gzip = bytes.starts_with(&GZIP_MAGIC);
+        Self::new(path, items, gzip, Box::new(std::io::Cursor::new(bytes)))
+    }
+
+    /// Reads the first frame's timestep from `source` (gzip-compressed if `gzip`).
+    fn new(
+        path: &Path,
+        items: Items,
+        gzip: bool,
+        source: Box<dyn Read>,
+    ) -> Result<Self, ImportError> {
         let lines: Box<dyn BufRead> = if gzip {
             Box::new(BufReader::with_capacity(
                 1 << 16,
-                flate2::read::MultiGzDecoder::new(file),
+                flate2::read::MultiGzDecoder::new(source),
             ))
         } else {
-            Box::new(BufReader::with_capacity(1 << 16, file))
+            Box::new(BufReader::with_capacity(1 << 16, source))
         };
         let mut reader = Self {
             path: path.to_path_buf(),
@@ -208,15 +230,21 @@ impl FrameReader {
             ));
         }
         let value = self.expect_line("the timestep")?;
-        let step = value.trim().parse::<u64>().map_err(|_| {
-            self.error(
-                self.line,
-                format!(
-                    "timestep `{}` is not a whole number ≥ 0",
-                    shorten(value.trim())
-                ),
-            )
-        })?;
+        let step = value
+            .trim()
+            .parse::<u64>()
+            .ok()
+            .filter(|&s| s <= MAX_TIMESTEP)
+            .ok_or_else(|| {
+                self.error(
+                    self.line,
+                    format!(
+                        "timestep `{}` is not a whole number in 0..={MAX_TIMESTEP} (LIGGGHTS' \
+                         64-bit signed timestep)",
+                        shorten(value.trim())
+                    ),
+                )
+            })?;
         Ok(Some((step, line)))
     }
 
@@ -349,6 +377,16 @@ impl DumpSet {
             items,
             pending,
             open: Vec::new(),
+        })
+    }
+
+    /// One dump file whose bytes are already in memory (plain or gzip); `path` names it in
+    /// messages. Its first header is read (and checked) here.
+    pub fn from_bytes(path: &Path, bytes: Vec<u8>, items: Items) -> Result<Self, ImportError> {
+        Ok(Self {
+            items,
+            pending: Vec::new(),
+            open: vec![FrameReader::from_bytes(path, items, bytes)?],
         })
     }
 

@@ -111,6 +111,7 @@ pub fn import(
         ),
     };
     let (step_t0, every) = (atoms.step_t0, opts.sample_every as u64);
+    // no overflow: the atom dumps hold t1 = t0 + τ, a timestep ≤ dump::MAX_TIMESTEP
     let step_t1 = step_t0 + opts.period_steps;
     let mut set = DumpSet::open(&dumps.contacts, Items::Entries)?;
     let (mut sampled, mut skipped) = (0u64, 0u64);
@@ -198,7 +199,16 @@ struct AtomSnapshots {
 /// Reads every atom frame; keeps those at `t0 + kτ` (t0 = the first) while they follow each
 /// other, as snapshots in tdex ids.
 fn read_snapshots(pattern: &str, period: u64, dt: f64) -> Result<AtomSnapshots, ImportError> {
-    let mut set = DumpSet::open(pattern, Items::Atoms)?;
+    snapshots_of(DumpSet::open(pattern, Items::Atoms)?, pattern, period, dt)
+}
+
+/// [`read_snapshots`] of an opened set of atom dumps (`pattern` names them in messages).
+fn snapshots_of(
+    mut set: DumpSet,
+    pattern: &str,
+    period: u64,
+    dt: f64,
+) -> Result<AtomSnapshots, ImportError> {
     let step_t0 = set.next_timestep().expect("a dump set has a frame");
     let mut ids: Vec<u64> = Vec::new();
     let mut snapshots: Vec<Snapshot> = Vec::new();
@@ -239,7 +249,7 @@ fn read_snapshots(pattern: &str, period: u64, dt: f64) -> Result<AtomSnapshots, 
              atom dump, + τ = {period} steps); other atom timesteps found: {}. Dump the atoms \
              at t0 and every τ steps after it (or give --tau / --tau-rev for the period that \
              was dumped)",
-            step_t0 + period,
+            step_t0.saturating_add(period),
             if others.is_empty() {
                 "none".to_string()
             } else {
@@ -254,6 +264,53 @@ fn read_snapshots(pattern: &str, period: u64, dt: f64) -> Result<AtomSnapshots, 
         files_t0,
         skipped,
     })
+}
+
+/// The atom snapshots an import would take from one dump file held in memory (`path` names
+/// it in messages), `τ = period` steps apart; the number of snapshots. For fuzzing.
+pub(crate) fn atom_snapshots_of_bytes(
+    path: &Path,
+    bytes: Vec<u8>,
+    period: u64,
+) -> Result<usize, ImportError> {
+    let set = DumpSet::from_bytes(path, bytes, Items::Atoms)?;
+    let atoms = snapshots_of(set, &path.display().to_string(), period, 1e-5)?;
+    Ok(atoms.snapshots.len())
+}
+
+/// Samples every contact frame of one dump file held in memory (`path` names it in
+/// messages) as an import does, the particles of t0 being LIGGGHTS ids `1..=particles` of
+/// `radius`, one sample every `every` steps; the rows made. For fuzzing.
+pub(crate) fn contact_rows_of_bytes(
+    path: &Path,
+    bytes: Vec<u8>,
+    particles: u64,
+    radius: f64,
+    every: u32,
+) -> Result<usize, ImportError> {
+    let ids: Vec<u64> = (1..=particles).collect();
+    let radii = vec![radius; ids.len()];
+    let contacts = Contacts {
+        ids: &ids,
+        radius: &radii,
+        law: ConductionLaw::new(
+            &crate::case::ConductionSpec::default(),
+            100.0,
+            100.0,
+            840.0,
+            1e7,
+        ),
+    };
+    let mut sampler = ContactSampler::new(every, 2 * every).expect("a positive multiple");
+    let mut set = DumpSet::from_bytes(path, bytes, Items::Entries)?;
+    let (mut pairs, mut rows, mut step) = (Vec::new(), 0, 0);
+    while let Some((_, parts)) = set.read_next(false)? {
+        contacts.sample(&parts, &mut pairs)?;
+        sampler.sample(step, pairs.iter().copied());
+        rows += sampler.drain_ready().len();
+        step += every as u64;
+    }
+    Ok(rows + sampler.finish().len())
 }
 
 fn files_display(files: &[PathBuf]) -> String {

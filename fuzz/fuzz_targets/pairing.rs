@@ -1,0 +1,10 @@
+//! Fuzz target `pairing`: Bytes as a pairing sidecar (`RECORDING.pairing.json`).
+
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    // Ok or Err are both fine; a panic, an abort or a runaway allocation is a finding.
+    let _ = extrapolate::fuzzing::run("pairing", data);
+});
