@@ -173,3 +173,14 @@ fn every_shipped_case_is_valid() {
         }
     }
 }
+
+#[test]
+fn a_drum_too_wide_for_its_neighbour_grid_is_refused_before_any_work() {
+    // 30 particles of 0.1 µm in a 3 cm drum: valid sizes, but ~10^13 grid cells
+    let tiny_grains =
+        edit("count = 250", "count = 30").replacen("radius = 0.005", "radius = 1.0e-7", 1);
+    assert_refused(
+        &tiny_grains.replacen("dt = 1.0e-4", "dt = 1.0e-9", 1),
+        &["drum.radius", "neighbour grid", "at most 3e7"],
+    );
+}

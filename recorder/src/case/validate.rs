@@ -8,6 +8,8 @@ use crate::insertion;
 pub const MAX_RAYLEIGH_FRACTION: f64 = 0.30;
 /// Largest accepted bed volume (at the random-loose packing 0.6) as a fraction of the drum.
 pub const MAX_FILL_FRACTION: f64 = 0.90;
+/// Largest neighbour grid a case may need (its cell index alone is 4 bytes a cell).
+pub const MAX_GRID_CELLS: f64 = 3.0e7;
 /// Packing fraction used to size the settled bed.
 const BED_PACKING: f64 = 0.60;
 
@@ -212,6 +214,21 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
                 100.0 * bed_volume / drum_volume,
                 drum_volume,
                 MAX_FILL_FRACTION * 100.0
+            ),
+        ));
+    }
+    // The neighbour grid spans the drum in cells of a diameter and a skin: a drum thousands
+    // of radii wide would ask the run for a grid larger than the machine, so it is refused
+    // here, before any work. Counted in cells of one diameter (an upper bound).
+    let cell = 2.0 * p.radius;
+    let grid_cells = (2.0 * (d.radius / cell + 1.0)).powi(2) * (d.length / cell + 2.0);
+    if grid_cells > MAX_GRID_CELLS {
+        return Err(refuse(
+            "drum.radius",
+            d.radius,
+            format!(
+                "with particles of radius {} m the neighbour grid would have {grid_cells:.2e} cells (drum {} m long); at most {MAX_GRID_CELLS:.0e} are allowed: use larger particles or a smaller drum",
+                p.radius, d.length
             ),
         ));
     }
