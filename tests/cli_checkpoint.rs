@@ -2,49 +2,38 @@
 //! checkpoint, in any stage, resumes to the recording an uninterrupted run writes, byte for
 //! byte; damaged checkpoints and journals are refused with a clear error.
 
-use crate::util::{run_tdex, tdex};
+use crate::cli_run::TINY_CASE;
+use crate::util::{costs_record_offset, run_tdex, tdex};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-/// A heated drum of 600 particles: 2 000 settling, 1 000 spin-up steps, then the period.
-const CASE: &str = r#"
-name = "checkpointed"
-seed = 5
-[particles]
-count = 600
-radius = 0.005
-[material]
-density = 2500.0
-youngs_modulus = 1.0e7
-poisson_ratio = 0.3
-conductivity = 100.0
-heat_capacity = 840.0
-[contact]
-particle_particle = { restitution = 0.2, friction = 0.3, rolling_friction = 0.002 }
-particle_wall = { restitution = 0.2, friction = 0.5, rolling_friction = 0.002 }
-[drum]
-radius = 0.06
-length = 0.1
-rotation_period = 1.0
-wall_temperature = 350.0
-[time]
-dt = 1.0e-4
-settle = 0.2
-spin_up = 0.1
-heating = 0.2
-[temperature]
-mode = "split"
-hot = 30.0
-cold = 10.0
-"#;
+/// The tiny case grown to 600 particles in a wider, longer, heated drum turning once a
+/// second: 2 000 settling, 1 000 spin-up steps, then the period.
+fn case_text() -> String {
+    let mut text = TINY_CASE.to_string();
+    for (from, to) in [
+        ("name = \"tiny\"", "name = \"checkpointed\""),
+        ("count = 250", "count = 600"),
+        ("radius = 0.05", "radius = 0.06"),
+        ("length = 0.06", "length = 0.1"),
+        (
+            "rotation_period = 2.0",
+            "rotation_period = 1.0\nwall_temperature = 350.0",
+        ),
+    ] {
+        assert!(text.contains(from), "{from} not in the tiny case");
+        text = text.replacen(from, to, 1);
+    }
+    text
+}
 
 /// τ = 0.6 s (6 000 steps) and two reference periods.
 const TABLE: [&str; 4] = ["--tau", "0.6", "--reference", "2"];
 
 fn setup(dir: &Path) -> PathBuf {
     let case = dir.join("case.toml");
-    std::fs::write(&case, CASE).unwrap();
+    std::fs::write(&case, case_text()).unwrap();
     case
 }
 
@@ -195,14 +184,7 @@ fn a_resumed_recording_with_costs_equals_an_uninterrupted_one_up_to_its_costs() 
     assert!(report["seconds_period"].as_f64().unwrap() > 0.0);
 
     let (a, b) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
-    let costs = |f: &[u8]| {
-        // the costs metadata record: opcode (1 byte) and length (8) before its name's length (4)
-        f.windows(10)
-            .position(|w| w == b"tdex.costs")
-            .expect("a costs record")
-            - 13
-    };
-    let (ca, cb) = (costs(&a), costs(&b));
+    let (ca, cb) = (costs_record_offset(&a), costs_record_offset(&b));
     assert_eq!(ca, cb, "the costs record starts at different offsets");
     assert!(
         a[..ca] == b[..cb],

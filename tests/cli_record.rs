@@ -135,14 +135,7 @@ fn the_recording_is_byte_identical_whatever_the_thread_count_up_to_its_costs() {
     record(&case, &a, &["--threads", "1"]);
     record(&case, &b, &["--threads", "2"]);
     let (a, b) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
-    // the costs metadata record: opcode (1 byte) and length (8) before its name's length (4)
-    let costs = |f: &[u8]| {
-        f.windows(10)
-            .position(|w| w == b"tdex.costs")
-            .expect("a costs record")
-            - 13
-    };
-    let (ca, cb) = (costs(&a), costs(&b));
+    let (ca, cb) = (costs_record_offset(&a), costs_record_offset(&b));
     assert_eq!(ca, cb, "the costs record starts at different offsets");
     assert!(
         ca > a.len() / 2,
