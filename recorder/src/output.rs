@@ -127,18 +127,44 @@ fn file_name(path: &Path) -> &Path {
     path.file_name().map_or(path, Path::new)
 }
 
-/// The hidden temporary file beside `dest`: `.<name>.partial-<pid>`.
-pub fn temp_path(dest: &Path) -> PathBuf {
+/// The name of `dest`'s temporary files without the process id: `.<name>.partial-`.
+fn temp_prefix(dest: &Path) -> String {
     let name = dest.file_name().map_or_else(
         || "tdex-output".into(),
         |n| n.to_string_lossy().into_owned(),
     );
-    dest.with_file_name(format!(".{name}.partial-{}", std::process::id()))
+    format!(".{name}.partial-")
 }
 
-/// Whether a file name is one of tdex's temporary files (left only by a killed process).
-pub fn is_temp_name(name: &str) -> bool {
-    name.starts_with('.') && name.contains(".partial-")
+/// The hidden temporary file beside `dest`: `.<name>.partial-<pid>`.
+pub fn temp_path(dest: &Path) -> PathBuf {
+    dest.with_file_name(format!("{}{}", temp_prefix(dest), std::process::id()))
+}
+
+/// Removes the temporary files of `dest` left by processes that no longer run (a killed
+/// run, before its work is resumed); on systems without `/proc` it leaves them.
+pub fn remove_stale_temps(dest: &Path) {
+    let dir = parent_dir(dest);
+    let prefix = temp_prefix(dest);
+    let (Ok(entries), true) = (std::fs::read_dir(dir), Path::new("/proc/self").exists()) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name
+            .to_string_lossy()
+            .strip_prefix(&prefix)
+            .map(str::to_owned)
+        else {
+            continue;
+        };
+        let dead = !pid.is_empty()
+            && pid.bytes().all(|b| b.is_ascii_digit())
+            && !Path::new("/proc").join(&pid).exists();
+        if dead {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
 }
 
 /// Makes a rename or a new file in `dir` durable (its directory entry survives a crash).

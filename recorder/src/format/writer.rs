@@ -139,11 +139,6 @@ impl RecordingWriter {
         self.rows_written + self.pending.len() as u64
     }
 
-    /// The hidden file the recording is written to until [`Self::finish`].
-    pub fn partial_path(&self) -> PathBuf {
-        crate::output::temp_path(&self.dest)
-    }
-
     /// Writes the last batch, the summary (with the collision-duration histogram) and the
     /// costs (if given: without them the file depends only on the run's inputs), ends the
     /// MCAP file and renames it into place.

@@ -96,8 +96,6 @@ pub struct OutputState<'a> {
     pub snapshots: Cow<'a, [Snapshot]>,
     pub sampler: Cow<'a, ContactSampler>,
     pub journal: JournalMark,
-    /// The partial output of the process that wrote the checkpoint (a resume removes it).
-    pub partial: PathBuf,
 }
 
 /// A run of `tdex record`, resumable.

@@ -171,37 +171,10 @@ pub fn resume(
     check(&options)?;
     let restored = checkpoint.restore(&case, path)?;
     // temporary files of the killed run (its output, a checkpoint it was writing)
-    remove_stale_temps(&dest);
-    remove_stale_temps(path);
+    crate::output::remove_stale_temps(&dest);
+    crate::output::remove_stale_temps(path);
     let saver = Saver::new(&run, path, run.checkpoint_every.expect("set above"))?;
     drive(&run, Some(saver), Some(restored), progress)
-}
-
-/// Removes the hidden temporary files of `dest` left by processes that no longer run (a
-/// killed recording); on systems without `/proc` it leaves them.
-fn remove_stale_temps(dest: &Path) {
-    let (Some(dir), Some(name)) = (dest.parent(), dest.file_name()) else {
-        return;
-    };
-    let prefix = format!(".{}.partial-", name.to_string_lossy());
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    if !Path::new("/proc/self").exists() {
-        return;
-    }
-    for entry in entries.flatten() {
-        let file = entry.file_name();
-        let pid = file
-            .to_string_lossy()
-            .strip_prefix(&prefix)
-            .map(str::to_owned);
-        if let Some(pid) = pid.filter(|p| !p.is_empty() && p.bytes().all(|b| b.is_ascii_digit())) {
-            if pid != std::process::id().to_string() && !Path::new("/proc").join(&pid).exists() {
-                let _ = std::fs::remove_file(entry.path());
-            }
-        }
-    }
 }
 
 fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
@@ -446,8 +419,6 @@ fn drive(
             )
         }
         Some(out) => {
-            // the killed run's output is incomplete and hidden; this run writes its own
-            let _ = std::fs::remove_file(&out.partial);
             let info = recording_info(case, run.case_path, run.case_toml, opts, out.run.clone());
             let mut writer = RecordingWriter::create(run.dest, info)?;
             writer.write_snapshot(&out.snapshots[0])?;
@@ -476,13 +447,11 @@ fn drive(
     if let Stage::Period { done } = stage {
         let began = Instant::now();
         let (period_base, recorder_base) = (elapsed.period, elapsed.recorder);
-        let partial = sink.writer.partial_path();
         let mut hook = PeriodSaver {
             run,
             saver: saver.as_mut(),
             run_at_t0: &run_at_t0,
             t0: &snapshots[0],
-            partial: &partial,
             elapsed,
             began,
         };
@@ -528,7 +497,6 @@ fn drive(
         for period in first..opts.reference_periods {
             let start = if period == first { done } else { 0 };
             let offset = period as u64 * opts.period_steps;
-            let partial = sink.writer.partial_path();
             run_phase(
                 &mut sim,
                 start,
@@ -541,7 +509,6 @@ fn drive(
                             snapshots: Cow::Borrowed(&snapshots),
                             sampler: Cow::Borrowed(&sampler),
                             journal,
-                            partial: partial.clone(),
                         };
                         let elapsed = Elapsed {
                             reference: base + began.elapsed().as_secs_f64(),
@@ -599,7 +566,6 @@ struct PeriodSaver<'a> {
     saver: Option<&'a mut Saver>,
     run_at_t0: &'a RunAtT0,
     t0: &'a Snapshot,
-    partial: &'a Path,
     /// Elapsed times when the period (re)started.
     elapsed: Elapsed,
     began: Instant,
@@ -629,7 +595,6 @@ impl PeriodCheckpoint for PeriodSaver<'_> {
             snapshots: Cow::Borrowed(std::slice::from_ref(self.t0)),
             sampler: Cow::Borrowed(sampler),
             journal: *journal,
-            partial: self.partial.to_path_buf(),
         };
         let elapsed = Elapsed {
             period: self.elapsed.period + self.began.elapsed().as_secs_f64(),
