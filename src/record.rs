@@ -74,21 +74,22 @@ pub fn run(plan: RecordPlan) -> Result<()> {
         RecordStart::Resume {
             path,
             checkpoint,
+            case,
             checkpoint_every,
         } => {
             let output = checkpoint.dest.clone();
             eprintln!("resuming from {}", checkpoint.header);
-            let name = checkpoint.case(&path)?.name;
             crate::with_workers(plan.threads, || {
                 Ok(record::resume(
                     *checkpoint,
+                    &case,
                     &path,
                     checkpoint_every,
                     &mut progress,
                 )?)
             })
             .with_context(|| format!("resuming {}", path.display()))?;
-            (output, name)
+            (output, case.name)
         }
     };
     bar.finish_and_clear();

@@ -182,6 +182,8 @@ pub enum RecordStart {
         /// The checkpoint file, read and checked.
         path: PathBuf,
         checkpoint: Box<recorder::record::Checkpoint<'static>>,
+        /// Its case, parsed and validated again from the text it stores.
+        case: Box<Case>,
         /// A new interval between checkpoints, if given.
         checkpoint_every: Option<f64>,
     },
@@ -243,11 +245,11 @@ impl Plan {
                 let start = match (resume, case) {
                     (Some(path), _) => {
                         let checkpoint = recorder::record::Checkpoint::read(&path)?;
-                        // the case text inside must still be a valid case
-                        checkpoint.case(&path)?;
+                        let case = checkpoint.case(&path)?;
                         RecordStart::Resume {
                             path,
                             checkpoint: Box::new(checkpoint),
+                            case: Box::new(case),
                             checkpoint_every,
                         }
                     }

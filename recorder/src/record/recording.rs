@@ -143,24 +143,24 @@ pub fn record_run(
     drive(run, saver, None, progress)
 }
 
-/// Resumes the run in which `checkpoint` (read from `path` by [`Checkpoint::read`]) was
-/// taken, writing further checkpoints to `path` every `every` seconds (default: as before).
+/// Resumes the run in which `checkpoint` (read from `path` by [`Checkpoint::read`], its
+/// case from [`Checkpoint::case`]) was taken, writing further checkpoints to `path` every `every` seconds (default: as before).
 /// The recording is the one the run would have written uninterrupted, to the byte, up to
 /// the costs record (which adds the wall times of both runs).
 pub fn resume(
     checkpoint: Checkpoint<'static>,
+    case: &Case,
     path: &Path,
     every: Option<f64>,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<RecordingSummary, RecordError> {
-    let case = checkpoint.case(path)?;
     let (case_toml, case_path) = (
         checkpoint.case_toml.clone().into_owned(),
         checkpoint.case_path.clone(),
     );
     let (options, dest) = (checkpoint.options.clone(), checkpoint.dest.clone());
     let run = RecordRun {
-        case: &case,
+        case,
         case_path: &case_path,
         case_toml: &case_toml,
         options: &options,
@@ -168,8 +168,7 @@ pub fn resume(
         checkpoint_every: Some(every.unwrap_or(checkpoint.every_seconds)),
         write_costs: checkpoint.write_costs,
     };
-    check(&options)?;
-    let restored = checkpoint.restore(&case, path)?;
+    let restored = checkpoint.restore(case, path)?;
     // temporary files of the killed run (its output, a checkpoint it was writing)
     crate::output::remove_stale_temps(&dest);
     crate::output::remove_stale_temps(path);
