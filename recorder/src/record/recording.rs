@@ -196,21 +196,54 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
 pub fn run_to_t0(
     case: &Case,
     progress: &mut dyn FnMut(Phase, u64, u64),
-) -> Result<Simulation, SimulationError> {
+) -> Result<Simulation, RecordError> {
     let mut sim = Simulation::new(case)?;
-    let (n_settle, n_spin) = (
-        case.steps_in(case.time.settle),
-        case.steps_in(case.time.spin_up),
-    );
-    sim.run(n_settle, REPORT_EVERY, &mut |s| {
-        progress(Phase::Settle, s, n_settle)
-    })?;
-    sim.start_rotation();
-    sim.run(n_spin, REPORT_EVERY, &mut |s| {
-        progress(Phase::SpinUp, s, n_spin)
-    })?;
-    sim.assign_temperatures();
+    advance_to_t0(
+        &mut sim,
+        Stage::Settle { done: 0 },
+        progress,
+        &mut |_, _| Ok(()),
+    )?;
     Ok(sim)
+}
+
+/// Settles and spins up from where `stage` stands (if it is before `t0`) and assigns the
+/// initial temperatures; `checkpoint` is offered the state between blocks of steps.
+/// Returns the stage reached: the start of the period.
+fn advance_to_t0(
+    sim: &mut Simulation,
+    mut stage: Stage,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+    checkpoint: &mut dyn FnMut(&Simulation, Stage) -> Result<(), RecordError>,
+) -> Result<Stage, RecordError> {
+    let time = &sim.case.time;
+    let (n_settle, n_spin) = (
+        sim.case.steps_in(time.settle),
+        sim.case.steps_in(time.spin_up),
+    );
+    if let Stage::Settle { done } = stage {
+        run_phase(
+            sim,
+            done,
+            n_settle,
+            &mut |d| progress(Phase::Settle, d, n_settle),
+            &mut |sim, done| checkpoint(sim, Stage::Settle { done }),
+        )?;
+        sim.start_rotation();
+        stage = Stage::SpinUp { done: 0 };
+    }
+    if let Stage::SpinUp { done } = stage {
+        run_phase(
+            sim,
+            done,
+            n_spin,
+            &mut |d| progress(Phase::SpinUp, d, n_spin),
+            &mut |sim, done| checkpoint(sim, Stage::SpinUp { done }),
+        )?;
+        sim.assign_temperatures();
+        stage = Stage::Period { done: 0 };
+    }
+    Ok(stage)
 }
 
 /// Writes the checkpoints of one run.
@@ -360,40 +393,21 @@ fn drive(
     };
 
     // to t0
-    let (n_settle, n_spin) = (
-        case.steps_in(case.time.settle),
-        case.steps_in(case.time.spin_up),
-    );
-    let (began, base) = (Instant::now(), elapsed.to_t0);
-    let to_t0 = |elapsed: &Elapsed| Elapsed {
-        to_t0: base + began.elapsed().as_secs_f64(),
-        ..*elapsed
-    };
-    let mut offer = |sim: &Simulation, stage: Stage, elapsed: Elapsed| match &mut saver {
-        Some(s) if s.due() => s.save(run, sim, stage, elapsed, None),
-        _ => Ok(()),
-    };
-    if let Stage::Settle { done } = stage {
-        run_phase(
+    if matches!(stage, Stage::Settle { .. } | Stage::SpinUp { .. }) {
+        let (began, base) = (Instant::now(), elapsed.to_t0);
+        let to_t0 = |elapsed: &Elapsed| Elapsed {
+            to_t0: base + began.elapsed().as_secs_f64(),
+            ..*elapsed
+        };
+        stage = advance_to_t0(
             &mut sim,
-            done,
-            n_settle,
-            &mut |d| progress(Phase::Settle, d, n_settle),
-            &mut |sim, done| offer(sim, Stage::Settle { done }, to_t0(&elapsed)),
+            stage,
+            progress,
+            &mut |sim, stage| match &mut saver {
+                Some(s) if s.due() => s.save(run, sim, stage, to_t0(&elapsed), None),
+                _ => Ok(()),
+            },
         )?;
-        sim.start_rotation();
-        stage = Stage::SpinUp { done: 0 };
-    }
-    if let Stage::SpinUp { done } = stage {
-        run_phase(
-            &mut sim,
-            done,
-            n_spin,
-            &mut |d| progress(Phase::SpinUp, d, n_spin),
-            &mut |sim, done| offer(sim, Stage::SpinUp { done }, to_t0(&elapsed)),
-        )?;
-        sim.assign_temperatures();
-        stage = Stage::Period { done: 0 };
         elapsed = to_t0(&elapsed);
     }
 
