@@ -3,7 +3,7 @@
 //! byte; damaged checkpoints and journals are refused with a clear error.
 
 use crate::cli_run::TINY_CASE;
-use crate::util::{costs_record_offset, run_tdex, tdex};
+use crate::util::{costs_record_offset, file_names, run_tdex, tdex};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -114,16 +114,6 @@ fn kill_when(
     }
 }
 
-/// Names of the files in `dir`, hidden ones included.
-fn names(dir: &Path) -> Vec<String> {
-    let mut n: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    n.sort();
-    n
-}
-
 #[test]
 fn a_recording_killed_in_every_stage_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
@@ -164,7 +154,7 @@ fn a_recording_killed_in_every_stage_resumes_to_the_same_bytes() {
         "the resumed recording differs; stops: {stops:#?}"
     );
     // the checkpoint, its journal and the killed runs' partial files are gone
-    assert_eq!(names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
+    assert_eq!(file_names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
 }
 
 #[test]

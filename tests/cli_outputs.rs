@@ -172,16 +172,6 @@ fn full_disks(root: &Path, tmpfs_kb: u64, free: u64, prepare: impl Fn(&Path)) ->
     disks
 }
 
-/// The file names in `dir`, sorted.
-fn names(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
-}
-
 /// Every file of `dir` but the filler, with its bytes.
 fn outputs(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     let mut all = files(dir);
@@ -260,7 +250,7 @@ fn record_on_a_full_disk_says_why_and_keeps_the_previous_recording() {
         let fresh = disk.dir.join("fresh.mcap");
         let o = record(&fresh, &|a| disk.tdex(a));
         assert_failed(&what, &o, &fresh, disk.reason(), false);
-        let left = names(&disk.dir);
+        let left = file_names(&disk.dir);
         let expected: &[&str] = match disk.full {
             Full::Tmpfs(_) => &["filler", "run.mcap"],
             Full::Ulimit(_) => &["run.mcap"],
@@ -334,7 +324,7 @@ fn extrapolate_and_report_on_a_full_disk_keep_the_previous_files() {
             outputs(&dir) == report_files,
             "{what}: the previous report changed"
         );
-        let mut left = names(&disk.dir);
+        let mut left = file_names(&disk.dir);
         left.retain(|n| n != "filler");
         assert_eq!(left, ["extra.mcap", "report"], "{what}: files left");
     }
@@ -377,7 +367,7 @@ fn record_into_a_read_only_disk_or_an_unwritable_directory_says_why() {
             let o = record(&dest, &[]);
             assert_failed("read-only", &o, &dest, "read-only file system", true);
             assert_eq!(std::fs::read(&dest).unwrap(), previous);
-            assert_eq!(names(&dir), ["run.mcap"]);
+            assert_eq!(file_names(&dir), ["run.mcap"]);
         }
         Err(e) => eprintln!("skipped (read-only disk): {e}"),
     }
@@ -426,7 +416,7 @@ fn record_into_a_read_only_disk_or_an_unwritable_directory_says_why() {
                 true,
             );
             assert_eq!(std::fs::read(&dest).unwrap(), previous);
-            assert_eq!(names(&dir), ["run.mcap"]);
+            assert_eq!(file_names(&dir), ["run.mcap"]);
         }
         None => eprintln!("skipped (unwritable directory): setpriv cannot run tdex as nobody"),
     }
