@@ -41,3 +41,13 @@ pub fn norm2(a: Vec3) -> f64 {
 pub fn tangential(a: Vec3, n: Vec3) -> Vec3 {
     sub(a, scale(n, dot(a, n)))
 }
+
+/// `a` where `keep_a`, else `b`: both already computed, so this is a select, not a branch.
+#[inline(always)]
+pub fn select(keep_a: bool, a: Vec3, b: Vec3) -> Vec3 {
+    [
+        if keep_a { a[0] } else { b[0] },
+        if keep_a { a[1] } else { b[1] },
+        if keep_a { a[2] } else { b[2] },
+    ]
+}

@@ -2,6 +2,7 @@
 //! owns only scratch data; every set is passed to `step` explicitly.
 
 use crate::contact::contact_sphere_sphere::{self as sphere_sphere, SphereState};
+use crate::contact::pair_batch::{PairBatch, PairConstants, PairResponse, SphereArrays};
 use crate::contact::{contact_sphere_wall as sphere_wall, hertz_mindlin, ContactHistory, PairLaw};
 use crate::counters::{timed, Counters};
 use crate::heat::ConductionLaw;
@@ -128,17 +129,21 @@ pub fn pair_interactions(
         uniform_pair,
         ..
     } = neighbors;
-    let uniform_pair = *uniform_pair;
     let layers = layer_start.len().saturating_sub(1);
-    let state = |i: usize| SphereState {
-        pos: pos[i],
-        vel: vel[i],
-        omega: omega[i],
-        radius: radius[i],
-        mass: mass[i],
+    let spheres = SphereArrays {
+        pos,
+        vel,
+        omega,
+        radius,
+        mass,
+        temp,
     };
-    let dt = params.dt;
-    let (law, heat) = (&params.particle_particle, &params.conduction);
+    let constants = PairConstants {
+        law: &params.particle_particle,
+        heat: &params.conduction,
+        dt: params.dt,
+        uniform_pair: *uniform_pair,
+    };
     let mut pairs = 0;
     for phase in 0..2 {
         // task k owns layer l = phase + 2k: it writes the slots of l and l + 1 and the
@@ -158,50 +163,88 @@ pub fn pair_interactions(
             let l = layer(k);
             let first_slot = layer_start[l] as usize;
             let first_entry = offsets[first_slot] as usize;
+            let mut batch = PairBatch::default();
+            // the owner's sums are kept apart and added once its contacts are done, as
+            // each pair's partner sums are added in pair order: the order of every sum is
+            // fixed by the list alone
+            let mut owner = Owner::default();
+            let mut scatter = |i: usize, j: usize, r: PairResponse| {
+                if i != owner.slot {
+                    owner.add_to((f, t, q), first_slot);
+                    owner = Owner::new(i);
+                }
+                owner.force = add(owner.force, r.force);
+                owner.torque = add(owner.torque, r.torque_owner);
+                owner.heat_flow += r.heat_flow;
+                let jl = j - first_slot;
+                f[jl] = sub(f[jl], r.force);
+                t[jl] = add(t[jl], r.torque_partner);
+                q[jl] -= r.heat_flow;
+            };
             let mut touching_pairs = 0;
             for i in first_slot..layer_start[l + 1] as usize {
-                let si = state(i);
-                let (mut fi, mut ti, mut qi) = ([0.0; 3], [0.0; 3], 0.0);
+                let (pos_i, radius_i) = (pos[i], radius[i]);
                 for e in offsets[i] as usize..offsets[i + 1] as usize {
                     let j = partners[e] as usize;
-                    let delta = sub(si.pos, pos[j]);
+                    let delta = sub(pos_i, pos[j]);
                     let local = e - first_entry;
-                    let Some(r2) = sphere_sphere::overlapping(delta, si.radius, radius[j]) else {
+                    let Some(r2) = sphere_sphere::overlapping(delta, radius_i, radius[j]) else {
                         if touch[local] {
                             h[local] = ContactHistory::default();
                             touch[local] = false;
                         }
                         continue;
                     };
-                    let sj = state(j);
-                    let eff = uniform_pair.unwrap_or_else(|| {
-                        sphere_sphere::effective(si.radius, sj.radius, si.mass, sj.mass)
-                    });
-                    let c = sphere_sphere::kinematics(&si, &sj, delta, r2, eff);
-                    let resp = hertz_mindlin::respond(law, &c.kinematics, &mut h[local], dt);
                     touch[local] = true;
-                    let jl = j - first_slot;
-                    fi = add(fi, resp.force);
-                    f[jl] = sub(f[jl], resp.force);
-                    ti = add(ti, resp.torque_on_i(c.lever_i));
-                    t[jl] = add(t[jl], resp.torque_on_partner(c.lever_j));
-                    let conductance = heat.pair_conductivity
-                        * heat.pair_area(c.distance, si.radius, radius[j]).sqrt();
-                    let flow = conductance * (temp[j] - temp[i]);
-                    qi += flow;
-                    q[jl] -= flow;
                     touching_pairs += 1;
+                    if batch.push(i, j, local, delta, r2) {
+                        batch.evaluate(&constants, &spheres, h, &mut scatter);
+                    }
                 }
-                let il = i - first_slot;
-                f[il] = add(f[il], fi);
-                t[il] = add(t[il], ti);
-                q[il] += qi;
             }
+            batch.evaluate(&constants, &spheres, h, &mut scatter);
+            owner.add_to((f, t, q), first_slot);
             touching_pairs
         };
         pairs += for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work);
     }
     2 * pairs
+}
+
+/// The sums of the particle whose contacts the pair stage is handing out.
+struct Owner {
+    slot: usize,
+    force: Vec3,
+    torque: Vec3,
+    heat_flow: f64,
+}
+
+impl Default for Owner {
+    fn default() -> Self {
+        Self::new(usize::MAX)
+    }
+}
+
+impl Owner {
+    fn new(slot: usize) -> Self {
+        Self {
+            slot,
+            force: [0.0; 3],
+            torque: [0.0; 3],
+            heat_flow: 0.0,
+        }
+    }
+
+    /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.
+    fn add_to(&self, (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]), first_slot: usize) {
+        if self.slot == usize::MAX {
+            return;
+        }
+        let il = self.slot - first_slot;
+        f[il] = add(f[il], self.force);
+        t[il] = add(t[il], self.torque);
+        q[il] += self.heat_flow;
+    }
 }
 
 /// A task's force, torque, heat-flow, history and touching pieces.

@@ -124,6 +124,18 @@ pub fn respond(
     history: &mut ContactHistory,
     dt: f64,
 ) -> ContactResponse {
+    respond_with(law.rolling_model, law, k, history, dt)
+}
+
+/// [`respond`] with the rolling model passed apart (a constant there removes its match).
+#[inline(always)]
+pub fn respond_with(
+    rolling_model: RollingModel,
+    law: &PairLaw,
+    k: &ContactKinematics,
+    history: &mut ContactHistory,
+    dt: f64,
+) -> ContactResponse {
     let en = k.normal;
     let vn = dot(k.rel_vel, en);
     let vt = sub(k.rel_vel, scale(en, vn));
@@ -139,22 +151,20 @@ pub fn respond(
     // LIGGGHTS leaves limitForce off: the force may turn slightly attractive as the pair separates
     let fn_mag = kn * k.overlap - gamma_n * vn;
 
-    let mut shear = add(history.shear, scale(slip, dt));
-    shear = tangential(shear, en);
-    let mut ft = scale(shear, -kt);
+    let shear = tangential(add(history.shear, scale(slip, dt)), en);
+    let ft_spring = scale(shear, -kt);
     let ft_spring2 = kt * kt * norm2(shear);
     let ft_max = law.friction * fn_mag.abs();
-    // squares compared: the root is only needed when the contact slides
-    if ft_spring2 > ft_max * ft_max {
-        let ft_spring = ft_spring2.sqrt();
-        ft = scale(ft, ft_max / ft_spring);
-        shear = scale(ft, -1.0 / kt);
-    } else {
-        ft = sub(ft, scale(slip, gamma_t));
-    }
-    history.shear = shear;
+    // both outcomes are computed and one is kept: without a branch the pair stage evaluates
+    // several contacts per instruction (`pair_batch`)
+    let sliding = ft_spring2 > ft_max * ft_max;
+    let ft_slide = scale(ft_spring, ft_max / ft_spring2.sqrt());
+    let ft_stick = sub(ft_spring, scale(slip, gamma_t));
+    let ft = select(sliding, ft_slide, ft_stick);
+    history.shear = select(sliding, scale(ft_slide, -1.0 / kt), shear);
 
-    let rolling_torque = rolling::torque(law, k, kn, kt, fn_mag, &mut history.roll, dt);
+    let rolling_torque =
+        rolling::torque(rolling_model, law, k, kn, kt, fn_mag, &mut history.roll, dt);
     ContactResponse {
         force: add(scale(en, fn_mag), ft),
         moment_arm_torque: cross(en, ft),

@@ -3,6 +3,7 @@
 pub mod contact_sphere_sphere;
 pub mod contact_sphere_wall;
 pub mod hertz_mindlin;
+pub mod pair_batch;
 pub mod rolling;
 
 pub use hertz_mindlin::{ContactHistory, ContactKinematics, ContactResponse, PairLaw};

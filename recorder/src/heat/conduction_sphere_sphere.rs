@@ -44,15 +44,17 @@ impl ConductionLaw {
     pub fn pair_area(&self, r: f64, ri: f64, rj: f64) -> f64 {
         let radsum = ri + rj;
         let overlap = (radsum - r) * self.overlap_correction;
-        match self.area {
-            ContactArea::Overlap => {
-                let r = radsum - overlap;
-                let raddiff = ri - rj;
-                let r2 = r * r;
-                -std::f64::consts::FRAC_PI_4 * (r2 - radsum * radsum) * (r2 - raddiff * raddiff)
-                    / r2
-            }
-            ContactArea::Hertz => std::f64::consts::PI * (ri * rj / radsum) * overlap,
+        let r = radsum - overlap;
+        let raddiff = ri - rj;
+        let r2 = r * r;
+        let lens =
+            -std::f64::consts::FRAC_PI_4 * (r2 - radsum * radsum) * (r2 - raddiff * raddiff) / r2;
+        let hertz = std::f64::consts::PI * (ri * rj / radsum) * overlap;
+        // both computed, one kept: a select, which the batched pair law needs (`pair_batch`)
+        if self.area == ContactArea::Overlap {
+            lens
+        } else {
+            hertz
         }
     }
 

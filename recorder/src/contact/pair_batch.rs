@@ -1,0 +1,462 @@
+//! Touching sphere–sphere pairs gathered into lanes and evaluated together.
+//!
+//! The contact scan's overlap test is a coin toss for the branch predictor; when the law runs
+//! right behind it, every miss throws away the law's long chain of roots and divisions in
+//! flight. Gathered here, the law runs over a batch without a branch (`hertz_mindlin` keeps
+//! both outcomes of each cap and selects), so the compiler evaluates several contacts per
+//! instruction, as wide as the CPU allows. Every lane does the same IEEE operations as a
+//! lone contact would, so the results do not depend on the width.
+
+use super::contact_sphere_sphere::{self as sphere_sphere, SphereState};
+use super::{hertz_mindlin, ContactHistory, PairLaw};
+use crate::case::RollingModel;
+use crate::heat::ConductionLaw;
+use crate::math::*;
+
+/// Contacts evaluated together: two AVX-512 vectors of doubles.
+pub const LANES: usize = 16;
+
+/// The per-particle arrays the law reads.
+#[derive(Clone, Copy)]
+pub struct SphereArrays<'a> {
+    pub pos: &'a [Vec3],
+    pub vel: &'a [Vec3],
+    pub omega: &'a [Vec3],
+    pub radius: &'a [f64],
+    pub mass: &'a [f64],
+    pub temp: &'a [f64],
+}
+
+/// What the law gives each contact of a batch: the force on the owner (the partner gets its
+/// negative), both torques, and the heat flow into the owner.
+#[derive(Debug, Clone, Copy)]
+pub struct PairResponse {
+    pub force: Vec3,
+    pub torque_owner: Vec3,
+    pub torque_partner: Vec3,
+    pub heat_flow: f64,
+}
+
+/// Up to [`LANES`] touching pairs, one array per field so each lane loop reads a vector.
+pub struct PairBatch {
+    len: usize,
+    owner: [u32; LANES],
+    partner: [u32; LANES],
+    /// Index of the pair's history in the history slice handed to `evaluate`.
+    entry: [u32; LANES],
+    delta: [[f64; LANES]; 3],
+    r2: [f64; LANES],
+    lanes: Lanes,
+}
+
+/// The law's inputs and outputs in structure-of-arrays form.
+struct Lanes {
+    vel_i: [[f64; LANES]; 3],
+    vel_j: [[f64; LANES]; 3],
+    omega_i: [[f64; LANES]; 3],
+    omega_j: [[f64; LANES]; 3],
+    radius_i: [f64; LANES],
+    radius_j: [f64; LANES],
+    r_eff: [f64; LANES],
+    m_eff: [f64; LANES],
+    temp_diff: [f64; LANES],
+    shear: [[f64; LANES]; 3],
+    roll: [[f64; LANES]; 3],
+    force: [[f64; LANES]; 3],
+    torque_i: [[f64; LANES]; 3],
+    torque_j: [[f64; LANES]; 3],
+    heat_flow: [f64; LANES],
+}
+
+impl Default for PairBatch {
+    fn default() -> Self {
+        let zero = [0.0; LANES];
+        Self {
+            len: 0,
+            owner: [0; LANES],
+            partner: [0; LANES],
+            entry: [0; LANES],
+            delta: [zero; 3],
+            r2: zero,
+            lanes: Lanes {
+                vel_i: [zero; 3],
+                vel_j: [zero; 3],
+                omega_i: [zero; 3],
+                omega_j: [zero; 3],
+                radius_i: zero,
+                radius_j: zero,
+                r_eff: zero,
+                m_eff: zero,
+                temp_diff: zero,
+                shear: [zero; 3],
+                roll: [zero; 3],
+                force: [zero; 3],
+                torque_i: [zero; 3],
+                torque_j: [zero; 3],
+                heat_flow: zero,
+            },
+        }
+    }
+}
+
+/// Constants of one evaluation.
+#[derive(Clone, Copy)]
+pub struct PairConstants<'a> {
+    pub law: &'a PairLaw,
+    pub heat: &'a ConductionLaw,
+    pub dt: f64,
+    /// `(R*, m*)` of every pair when all spheres are equal.
+    pub uniform_pair: Option<(f64, f64)>,
+}
+
+impl PairBatch {
+    /// Adds the touching pair `(owner, partner)` whose centres are `delta` apart (`r2` its
+    /// squared length) and whose history is `entry`; true when the batch is full.
+    #[inline(always)]
+    pub fn push(
+        &mut self,
+        owner: usize,
+        partner: usize,
+        entry: usize,
+        delta: Vec3,
+        r2: f64,
+    ) -> bool {
+        let l = self.len;
+        self.owner[l] = owner as u32;
+        self.partner[l] = partner as u32;
+        self.entry[l] = entry as u32;
+        for (d, &x) in self.delta.iter_mut().zip(&delta) {
+            d[l] = x;
+        }
+        self.r2[l] = r2;
+        self.len += 1;
+        self.len == LANES
+    }
+
+    /// Evaluates the batch's contacts, advances their histories in `history`, hands each
+    /// contact's response to `scatter(owner, partner, response)` in the order they were
+    /// pushed, and empties the batch.
+    pub fn evaluate(
+        &mut self,
+        constants: &PairConstants,
+        spheres: &SphereArrays,
+        history: &mut [ContactHistory],
+        mut scatter: impl FnMut(usize, usize, PairResponse),
+    ) {
+        let n = self.len;
+        if n == 0 {
+            return;
+        }
+        self.gather(constants, spheres, history);
+        run_lanes(&mut self.lanes, &self.delta, &self.r2, n, constants);
+        let lanes = &self.lanes;
+        for l in 0..n {
+            let lane3 = |a: &[[f64; LANES]; 3]| [a[0][l], a[1][l], a[2][l]];
+            history[self.entry[l] as usize] = ContactHistory {
+                shear: lane3(&lanes.shear),
+                roll: lane3(&lanes.roll),
+            };
+            let response = PairResponse {
+                force: lane3(&lanes.force),
+                torque_owner: lane3(&lanes.torque_i),
+                torque_partner: lane3(&lanes.torque_j),
+                heat_flow: lanes.heat_flow[l],
+            };
+            scatter(self.owner[l] as usize, self.partner[l] as usize, response);
+        }
+        self.len = 0;
+    }
+
+    /// Copies every lane's sphere states and history into the lane arrays.
+    fn gather(
+        &mut self,
+        constants: &PairConstants,
+        spheres: &SphereArrays,
+        history: &[ContactHistory],
+    ) {
+        let lanes = &mut self.lanes;
+        for l in 0..self.len {
+            let (i, j) = (self.owner[l] as usize, self.partner[l] as usize);
+            let h = &history[self.entry[l] as usize];
+            for a in 0..3 {
+                lanes.vel_i[a][l] = spheres.vel[i][a];
+                lanes.vel_j[a][l] = spheres.vel[j][a];
+                lanes.omega_i[a][l] = spheres.omega[i][a];
+                lanes.omega_j[a][l] = spheres.omega[j][a];
+                lanes.shear[a][l] = h.shear[a];
+                lanes.roll[a][l] = h.roll[a];
+            }
+            let (ri, rj) = (spheres.radius[i], spheres.radius[j]);
+            lanes.radius_i[l] = ri;
+            lanes.radius_j[l] = rj;
+            let (r_eff, m_eff) = constants.uniform_pair.unwrap_or_else(|| {
+                sphere_sphere::effective(ri, rj, spheres.mass[i], spheres.mass[j])
+            });
+            lanes.r_eff[l] = r_eff;
+            lanes.m_eff[l] = m_eff;
+            lanes.temp_diff[l] = spheres.temp[j] - spheres.temp[i];
+        }
+    }
+}
+
+/// Runs the law over the first `n` lanes with the widest vectors this CPU has.
+fn run_lanes(
+    lanes: &mut Lanes,
+    delta: &[[f64; LANES]; 3],
+    r2: &[f64; LANES],
+    n: usize,
+    constants: &PairConstants,
+) {
+    macro_rules! with_model {
+        ($f:ident) => {
+            match constants.law.rolling_model {
+                RollingModel::Epsd2 => $f::<EPSD2>(lanes, delta, r2, n, constants),
+                RollingModel::Cdt => $f::<CDT>(lanes, delta, r2, n, constants),
+                RollingModel::Off => $f::<OFF>(lanes, delta, r2, n, constants),
+            }
+        };
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU has AVX-512F, checked just above
+            return unsafe { with_model!(lanes_avx512) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2, checked just above
+            return unsafe { with_model!(lanes_avx2) };
+        }
+    }
+    with_model!(law_lanes)
+}
+
+const EPSD2: u8 = 0;
+const CDT: u8 = 1;
+const OFF: u8 = 2;
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn lanes_avx512<const MODEL: u8>(
+    lanes: &mut Lanes,
+    delta: &[[f64; LANES]; 3],
+    r2: &[f64; LANES],
+    n: usize,
+    constants: &PairConstants,
+) {
+    law_lanes::<MODEL>(lanes, delta, r2, n, constants)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lanes_avx2<const MODEL: u8>(
+    lanes: &mut Lanes,
+    delta: &[[f64; LANES]; 3],
+    r2: &[f64; LANES],
+    n: usize,
+    constants: &PairConstants,
+) {
+    law_lanes::<MODEL>(lanes, delta, r2, n, constants)
+}
+
+/// The law for lanes `0..n`: the same functions a lone contact goes through, inlined into a
+/// loop without branches.
+#[inline(always)]
+fn law_lanes<const MODEL: u8>(
+    lanes: &mut Lanes,
+    delta: &[[f64; LANES]; 3],
+    r2: &[f64; LANES],
+    n: usize,
+    constants: &PairConstants,
+) {
+    let model = match MODEL {
+        EPSD2 => RollingModel::Epsd2,
+        CDT => RollingModel::Cdt,
+        _ => RollingModel::Off,
+    };
+    let PairConstants { law, heat, dt, .. } = *constants;
+    let n = n.min(LANES);
+    for l in 0..n {
+        let lane3 = |a: &[[f64; LANES]; 3]| [a[0][l], a[1][l], a[2][l]];
+        let si = SphereState {
+            pos: [0.0; 3], // the kinematics read only `delta`
+            vel: lane3(&lanes.vel_i),
+            omega: lane3(&lanes.omega_i),
+            radius: lanes.radius_i[l],
+            mass: 0.0, // (R*, m*) come in lane arrays
+        };
+        let sj = SphereState {
+            vel: lane3(&lanes.vel_j),
+            omega: lane3(&lanes.omega_j),
+            radius: lanes.radius_j[l],
+            ..si
+        };
+        let c = sphere_sphere::kinematics(
+            &si,
+            &sj,
+            lane3(delta),
+            r2[l],
+            (lanes.r_eff[l], lanes.m_eff[l]),
+        );
+        let mut history = ContactHistory {
+            shear: lane3(&lanes.shear),
+            roll: lane3(&lanes.roll),
+        };
+        let resp = hertz_mindlin::respond_with(model, law, &c.kinematics, &mut history, dt);
+        let torque_i = resp.torque_on_i(c.lever_i);
+        let torque_j = resp.torque_on_partner(c.lever_j);
+        let conductance =
+            heat.pair_conductivity * heat.pair_area(c.distance, si.radius, sj.radius).sqrt();
+        for a in 0..3 {
+            lanes.shear[a][l] = history.shear[a];
+            lanes.roll[a][l] = history.roll[a];
+            lanes.force[a][l] = resp.force[a];
+            lanes.torque_i[a][l] = torque_i[a];
+            lanes.torque_j[a][l] = torque_j[a];
+        }
+        lanes.heat_flow[l] = conductance * lanes.temp_diff[l];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case::{ConductionSpec, ContactArea, PairCoefficients};
+    use rand_xoshiro::rand_core::{Rng, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// Random touching pairs of unequal spheres: overlaps up to 5 % of a radius, speeds and
+    /// spins large enough that some contacts slide and some rolling springs are capped.
+    fn contacts(
+        seed: u64,
+        count: usize,
+    ) -> (
+        Vec<Vec3>,
+        Vec<Vec3>,
+        Vec<Vec3>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<f64>,
+        Vec<ContactHistory>,
+    ) {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        let mut u = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let mut v3 = |s: f64| [s * u(), s * u(), s * u()];
+        let (mut pos, mut vel, mut omega, mut radius, mut mass, mut temp, mut hist) =
+            (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+        for _ in 0..count {
+            let (ri, rj) = (
+                0.005 * (1.0 + 0.2 * v3(1.0)[0]),
+                0.004 * (1.0 + 0.2 * v3(1.0)[0]),
+            );
+            let dir = v3(1.0);
+            let n = scale(dir, 1.0 / norm2(dir).sqrt());
+            let gap = (ri + rj) * (1.0 - 0.025 * (1.0 + v3(1.0)[0]));
+            pos.extend([[0.0; 3], scale(n, gap)]);
+            vel.extend([v3(0.5), v3(0.5)]);
+            omega.extend([v3(50.0), v3(50.0)]);
+            radius.extend([ri, rj]);
+            mass.extend([2500.0 * 4.19 * ri * ri * ri, 2500.0 * 4.19 * rj * rj * rj]);
+            temp.extend([20.0 + 10.0 * v3(1.0)[0], 20.0 + 10.0 * v3(1.0)[0]]);
+            hist.push(ContactHistory {
+                shear: v3(2e-4),
+                roll: v3(6e-6),
+            });
+        }
+        (pos, vel, omega, radius, mass, temp, hist)
+    }
+
+    #[test]
+    fn a_batch_gives_every_contact_the_bits_it_gets_alone() {
+        let coefficients = PairCoefficients {
+            restitution: 0.2,
+            friction: 0.3,
+            rolling_friction: 0.002,
+        };
+        for model in [RollingModel::Epsd2, RollingModel::Cdt, RollingModel::Off] {
+            for area in [ContactArea::Overlap, ContactArea::Hertz] {
+                let law = PairLaw::new(1e7, 0.3, &coefficients, model);
+                let spec = ConductionSpec {
+                    contact_area: area,
+                    youngs_modulus_real: Some(7e10),
+                };
+                let heat = ConductionLaw::new(&spec, 100.0, 100.0, 840.0, 1e7);
+                let constants = PairConstants {
+                    law: &law,
+                    heat: &heat,
+                    dt: 1e-4,
+                    uniform_pair: None,
+                };
+                // 37 pairs: two full batches and a part-filled one
+                let (pos, vel, omega, radius, mass, temp, start) = contacts(7, 37);
+                let spheres = SphereArrays {
+                    pos: &pos,
+                    vel: &vel,
+                    omega: &omega,
+                    radius: &radius,
+                    mass: &mass,
+                    temp: &temp,
+                };
+                let mut batched = start.clone();
+                let mut responses = vec![];
+                let mut batch = PairBatch::default();
+                let mut scatter = |i: usize, j: usize, r: PairResponse| responses.push((i, j, r));
+                for p in 0..start.len() {
+                    let delta = sub(pos[2 * p], pos[2 * p + 1]);
+                    if batch.push(2 * p, 2 * p + 1, p, delta, norm2(delta)) {
+                        batch.evaluate(&constants, &spheres, &mut batched, &mut scatter);
+                    }
+                }
+                batch.evaluate(&constants, &spheres, &mut batched, &mut scatter);
+                assert_eq!(responses.len(), start.len());
+
+                let (mut sliding, mut capped) = (0, 0);
+                for (p, &(i, j, r)) in responses.iter().enumerate() {
+                    assert_eq!((i, j), (2 * p, 2 * p + 1));
+                    let state = |k: usize| SphereState {
+                        pos: pos[k],
+                        vel: vel[k],
+                        omega: omega[k],
+                        radius: radius[k],
+                        mass: mass[k],
+                    };
+                    let (si, sj) = (state(i), state(j));
+                    let delta = sub(si.pos, sj.pos);
+                    let eff = sphere_sphere::effective(si.radius, sj.radius, si.mass, sj.mass);
+                    let c = sphere_sphere::kinematics(&si, &sj, delta, norm2(delta), eff);
+                    let mut alone = start[p];
+                    let resp = hertz_mindlin::respond(&law, &c.kinematics, &mut alone, 1e-4);
+                    let flow = heat.pair_conductivity
+                        * heat.pair_area(c.distance, si.radius, sj.radius).sqrt()
+                        * (temp[j] - temp[i]);
+                    let bits = |v: Vec3| v.map(f64::to_bits);
+                    assert_eq!(bits(r.force), bits(resp.force), "{model:?} pair {p}");
+                    assert_eq!(bits(r.torque_owner), bits(resp.torque_on_i(c.lever_i)));
+                    assert_eq!(
+                        bits(r.torque_partner),
+                        bits(resp.torque_on_partner(c.lever_j))
+                    );
+                    assert_eq!(r.heat_flow.to_bits(), flow.to_bits());
+                    assert_eq!(bits(batched[p].shear), bits(alone.shear));
+                    assert_eq!(bits(batched[p].roll), bits(alone.roll));
+                    // a sliding contact's tangential force is at the Coulomb limit
+                    let en = c.kinematics.normal;
+                    let fn_mag = dot(resp.force, en);
+                    let ft = norm2(tangential(resp.force, en)).sqrt();
+                    sliding += usize::from((ft - law.friction * fn_mag.abs()).abs() < 1e-9 * ft);
+                    // a capped rolling spring is at μr R* |Fn|
+                    let m_max = law.rolling_friction * c.kinematics.r_eff * fn_mag.abs();
+                    let m = norm2(alone.roll).sqrt();
+                    capped += usize::from((m - m_max).abs() < 1e-9 * m_max);
+                }
+                // the sample holds both outcomes of each cap
+                assert!(
+                    sliding > 0 && sliding < start.len(),
+                    "{model:?}: {sliding} sliding"
+                );
+                if model == RollingModel::Epsd2 {
+                    assert!(capped > 0 && capped < start.len(), "{capped} capped");
+                }
+            }
+        }
+    }
+}
