@@ -324,25 +324,34 @@ mod tests {
     use rand_xoshiro::rand_core::{Rng, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
 
-    /// Random touching pairs of unequal spheres: overlaps up to 5 % of a radius, speeds and
-    /// spins large enough that some contacts slide and some rolling springs are capped.
-    fn contacts(
-        seed: u64,
-        count: usize,
-    ) -> (
-        Vec<Vec3>,
-        Vec<Vec3>,
-        Vec<Vec3>,
-        Vec<f64>,
-        Vec<f64>,
-        Vec<f64>,
-        Vec<ContactHistory>,
-    ) {
+    /// Random touching pairs of unequal spheres (pair `p` is spheres `2p`, `2p + 1`).
+    #[derive(Default)]
+    struct Sample {
+        pos: Vec<Vec3>,
+        vel: Vec<Vec3>,
+        omega: Vec<Vec3>,
+        radius: Vec<f64>,
+        mass: Vec<f64>,
+        temp: Vec<f64>,
+        history: Vec<ContactHistory>,
+    }
+
+    /// Overlaps up to 5 % of a radius, speeds and spins large enough that some contacts
+    /// slide and some rolling springs are capped.
+    fn contacts(seed: u64, count: usize) -> Sample {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
         let mut u = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
         let mut v3 = |s: f64| [s * u(), s * u(), s * u()];
-        let (mut pos, mut vel, mut omega, mut radius, mut mass, mut temp, mut hist) =
-            (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+        let mut sample = Sample::default();
+        let Sample {
+            pos,
+            vel,
+            omega,
+            radius,
+            mass,
+            temp,
+            history: hist,
+        } = &mut sample;
         for _ in 0..count {
             let (ri, rj) = (
                 0.005 * (1.0 + 0.2 * v3(1.0)[0]),
@@ -362,7 +371,7 @@ mod tests {
                 roll: v3(6e-6),
             });
         }
-        (pos, vel, omega, radius, mass, temp, hist)
+        sample
     }
 
     #[test]
@@ -387,14 +396,23 @@ mod tests {
                     uniform_pair: None,
                 };
                 // 37 pairs: two full batches and a part-filled one
-                let (pos, vel, omega, radius, mass, temp, start) = contacts(7, 37);
+                let sample = contacts(7, 37);
+                let Sample {
+                    pos,
+                    vel,
+                    omega,
+                    radius,
+                    mass,
+                    temp,
+                    history: start,
+                } = &sample;
                 let spheres = SphereArrays {
-                    pos: &pos,
-                    vel: &vel,
-                    omega: &omega,
-                    radius: &radius,
-                    mass: &mass,
-                    temp: &temp,
+                    pos,
+                    vel,
+                    omega,
+                    radius,
+                    mass,
+                    temp,
                 };
                 let mut batched = start.clone();
                 let mut responses = vec![];
