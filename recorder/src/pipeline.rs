@@ -2,7 +2,7 @@
 //! owns only scratch data; every set is passed to `step` explicitly.
 
 use crate::contact::contact_sphere_sphere::{self as sphere_sphere, SphereState};
-use crate::contact::pair_batch::{PairBatch, PairConstants, PairResponse, SphereArrays};
+use crate::contact::pair_batch::{PairBatch, PairConstants, SphereArrays};
 use crate::contact::{contact_sphere_wall as sphere_wall, hertz_mindlin, ContactHistory, PairLaw};
 use crate::counters::{timed, Counters};
 use crate::heat::ConductionLaw;
@@ -168,19 +168,6 @@ pub fn pair_interactions(
             // each pair's partner sums are added in pair order: the order of every sum is
             // fixed by the list alone
             let mut owner = Owner::default();
-            let mut scatter = |i: usize, j: usize, r: PairResponse| {
-                if i != owner.slot {
-                    owner.add_to((f, t, q), first_slot);
-                    owner = Owner::new(i);
-                }
-                owner.force = add(owner.force, r.force);
-                owner.torque = add(owner.torque, r.torque_owner);
-                owner.heat_flow += r.heat_flow;
-                let jl = j - first_slot;
-                f[jl] = sub(f[jl], r.force);
-                t[jl] = add(t[jl], r.torque_partner);
-                q[jl] -= r.heat_flow;
-            };
             let mut touching_pairs = 0;
             for i in first_slot..layer_start[l + 1] as usize {
                 let (pos_i, radius_i) = (pos[i], radius[i]);
@@ -198,11 +185,13 @@ pub fn pair_interactions(
                     touch[local] = true;
                     touching_pairs += 1;
                     if batch.push(i, j, local, delta, r2) {
-                        batch.evaluate(&constants, &spheres, h, &mut scatter);
+                        batch.evaluate(&constants, &spheres, h);
+                        owner.scatter(&mut batch, (f, t, q), first_slot);
                     }
                 }
             }
-            batch.evaluate(&constants, &spheres, h, &mut scatter);
+            batch.evaluate(&constants, &spheres, h);
+            owner.scatter(&mut batch, (f, t, q), first_slot);
             owner.add_to((f, t, q), first_slot);
             touching_pairs
         };
@@ -233,6 +222,32 @@ impl Owner {
             torque: [0.0; 3],
             heat_flow: 0.0,
         }
+    }
+
+    /// Adds an evaluated batch's responses to the owners' and partners' sums of a task's
+    /// pieces starting at `first_slot`, and empties the batch.
+    #[inline(always)]
+    fn scatter(
+        &mut self,
+        batch: &mut PairBatch,
+        (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]),
+        first_slot: usize,
+    ) {
+        for l in 0..batch.len() {
+            let (i, j, r) = batch.response(l);
+            if i != self.slot {
+                self.add_to((&mut *f, &mut *t, &mut *q), first_slot);
+                *self = Owner::new(i);
+            }
+            self.force = add(self.force, r.force);
+            self.torque = add(self.torque, r.torque_owner);
+            self.heat_flow += r.heat_flow;
+            let jl = j - first_slot;
+            f[jl] = sub(f[jl], r.force);
+            t[jl] = add(t[jl], r.torque_partner);
+            q[jl] -= r.heat_flow;
+        }
+        batch.clear();
     }
 
     /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.

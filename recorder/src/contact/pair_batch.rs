@@ -133,15 +133,14 @@ impl PairBatch {
         self.len == LANES
     }
 
-    /// Evaluates the batch's contacts, advances their histories in `history`, hands each
-    /// contact's response to `scatter(owner, partner, response)` in the order they were
-    /// pushed, and empties the batch.
+    /// Evaluates the batch's contacts and advances their histories in `history`; the
+    /// responses are then read with [`PairBatch::response`] in the order the contacts were
+    /// pushed, and [`PairBatch::clear`] empties the batch.
     pub fn evaluate(
         &mut self,
         constants: &PairConstants,
         spheres: &SphereArrays,
         history: &mut [ContactHistory],
-        mut scatter: impl FnMut(usize, usize, PairResponse),
     ) {
         let n = self.len;
         if n == 0 {
@@ -151,19 +150,38 @@ impl PairBatch {
         run_lanes(&mut self.lanes, &self.delta, &self.r2, n, constants);
         let lanes = &self.lanes;
         for l in 0..n {
-            let lane3 = |a: &[[f64; LANES]; 3]| [a[0][l], a[1][l], a[2][l]];
             history[self.entry[l] as usize] = ContactHistory {
-                shear: lane3(&lanes.shear),
-                roll: lane3(&lanes.roll),
+                shear: lane3(&lanes.shear, l),
+                roll: lane3(&lanes.roll, l),
             };
-            let response = PairResponse {
-                force: lane3(&lanes.force),
-                torque_owner: lane3(&lanes.torque_i),
-                torque_partner: lane3(&lanes.torque_j),
-                heat_flow: lanes.heat_flow[l],
-            };
-            scatter(self.owner[l] as usize, self.partner[l] as usize, response);
         }
+    }
+
+    /// Contacts in the batch.
+    #[inline(always)]
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    #[inline(always)]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Owner slot, partner slot and response of the `l`-th contact pushed.
+    #[inline(always)]
+    pub fn response(&self, l: usize) -> (usize, usize, PairResponse) {
+        let lanes = &self.lanes;
+        let response = PairResponse {
+            force: lane3(&lanes.force, l),
+            torque_owner: lane3(&lanes.torque_i, l),
+            torque_partner: lane3(&lanes.torque_j, l),
+            heat_flow: lanes.heat_flow[l],
+        };
+        (self.owner[l] as usize, self.partner[l] as usize, response)
+    }
+
+    pub fn clear(&mut self) {
         self.len = 0;
     }
 
@@ -197,6 +215,12 @@ impl PairBatch {
             lanes.temp_diff[l] = spheres.temp[j] - spheres.temp[i];
         }
     }
+}
+
+/// Lane `l` of three lane arrays.
+#[inline(always)]
+fn lane3(a: &[[f64; LANES]; 3], l: usize) -> Vec3 {
+    [a[0][l], a[1][l], a[2][l]]
 }
 
 /// Runs the law over the first `n` lanes with the widest vectors this CPU has.
@@ -276,7 +300,7 @@ fn law_lanes<const MODEL: u8>(
     let PairConstants { law, heat, dt, .. } = *constants;
     let n = n.min(LANES);
     for l in 0..n {
-        let lane3 = |a: &[[f64; LANES]; 3]| [a[0][l], a[1][l], a[2][l]];
+        let lane3 = |a: &[[f64; LANES]; 3]| lane3(a, l);
         let si = SphereState {
             pos: [0.0; 3], // the kinematics read only `delta`
             vel: lane3(&lanes.vel_i),
@@ -417,14 +441,18 @@ mod tests {
                 let mut batched = start.clone();
                 let mut responses = vec![];
                 let mut batch = PairBatch::default();
-                let mut scatter = |i: usize, j: usize, r: PairResponse| responses.push((i, j, r));
+                let mut evaluate = |batch: &mut PairBatch| {
+                    batch.evaluate(&constants, &spheres, &mut batched);
+                    responses.extend((0..batch.len()).map(|l| batch.response(l)));
+                    batch.clear();
+                };
                 for p in 0..start.len() {
                     let delta = sub(pos[2 * p], pos[2 * p + 1]);
                     if batch.push(2 * p, 2 * p + 1, p, delta, norm2(delta)) {
-                        batch.evaluate(&constants, &spheres, &mut batched, &mut scatter);
+                        evaluate(&mut batch);
                     }
                 }
-                batch.evaluate(&constants, &spheres, &mut batched, &mut scatter);
+                evaluate(&mut batch);
                 assert_eq!(responses.len(), start.len());
 
                 let (mut sliding, mut capped) = (0, 0);
