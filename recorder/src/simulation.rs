@@ -15,9 +15,10 @@ use crate::wall::{WallMotion, WallSet};
 
 /// Standard gravity along −z (m/s²).
 pub const GRAVITY: f64 = 9.81;
-/// Verlet skin as a fraction of the particle diameter (0.3: fewer rebuilds than 0.2 for a few
-/// more list entries; measured faster on bench_drum with a short spin-up: docs/benchmarks.md).
-const SKIN_PER_DIAMETER: f64 = 0.3;
+/// Verlet skin as a fraction of the particle diameter (0.4: fewer rebuilds for more list
+/// entries; since the batched pair law an entry costs less than a rebuild's share, measured
+/// on bench_drum with a short spin-up: docs/benchmarks.md).
+const SKIN_PER_DIAMETER: f64 = 0.4;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SimulationError {
