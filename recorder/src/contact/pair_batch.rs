@@ -356,6 +356,19 @@ mod tests {
         history: Vec<ContactHistory>,
     }
 
+    impl Sample {
+        fn spheres(&self) -> SphereArrays<'_> {
+            SphereArrays {
+                pos: &self.pos,
+                vel: &self.vel,
+                omega: &self.omega,
+                radius: &self.radius,
+                mass: &self.mass,
+                temp: &self.temp,
+            }
+        }
+    }
+
     /// Overlaps up to 5 % of a radius, speeds and spins large enough that some contacts
     /// slide and some rolling springs are capped.
     fn contacts(seed: u64, count: usize) -> Sample {
@@ -417,23 +430,16 @@ mod tests {
                 };
                 // 37 pairs: two full batches and a part-filled one
                 let sample = contacts(7, 37);
-                let Sample {
+                let spheres = sample.spheres();
+                let SphereArrays {
                     pos,
                     vel,
                     omega,
                     radius,
                     mass,
                     temp,
-                    history: start,
-                } = &sample;
-                let spheres = SphereArrays {
-                    pos,
-                    vel,
-                    omega,
-                    radius,
-                    mass,
-                    temp,
-                };
+                } = spheres;
+                let start = &sample.history;
                 let mut batched = start.clone();
                 let mut responses = vec![];
                 let mut batch = PairBatch::default();
