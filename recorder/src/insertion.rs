@@ -92,7 +92,7 @@ pub fn lattice_site_count(radius: f64, drum_radius: f64, drum_length: f64, limit
 }
 
 /// Uniform in [0, 1) from the top 53 bits.
-fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
+pub(crate) fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
     (rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
 }
 

@@ -275,7 +275,8 @@ macro_rules! law_lanes_for {
     };
 }
 law_lanes_for!(lanes_avx512, "avx512f");
-// left scalar by the compiler's cost model, yet measured 6 % faster than the baseline build
+// left scalar by the compiler (no packed root or division in it), yet measured 6 % faster
+// than the baseline build (docs/benchmarks.md)
 law_lanes_for!(lanes_avx2, "avx2");
 
 /// The law for lanes `0..n`: the same functions a lone contact goes through, inlined into a
@@ -341,7 +342,8 @@ fn law_lanes<const MODEL: u8>(
 mod tests {
     use super::*;
     use crate::case::{ConductionSpec, ContactArea, PairCoefficients};
-    use rand_xoshiro::rand_core::{Rng, SeedableRng};
+    use crate::insertion::uniform;
+    use rand_xoshiro::rand_core::SeedableRng;
     use rand_xoshiro::Xoshiro256PlusPlus;
 
     /// Random touching pairs of unequal spheres (pair `p` is spheres `2p`, `2p + 1`).
@@ -373,7 +375,7 @@ mod tests {
     /// slide and some rolling springs are capped.
     fn contacts(seed: u64, count: usize) -> Sample {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let mut u = move || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0;
+        let mut u = move || 2.0 * uniform(&mut rng) - 1.0;
         let mut v3 = |s: f64| [s * u(), s * u(), s * u()];
         let mut sample = Sample::default();
         let Sample {
