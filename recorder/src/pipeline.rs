@@ -1,7 +1,8 @@
 //! One DEM step: integrate, broad phase, pair and wall interactions, integrate. The pipeline
 //! owns only scratch data; every set is passed to `step` explicitly.
 
-use crate::contact::contact_sphere_sphere::{self as sphere_sphere, SphereState};
+use crate::contact::contact_sphere_sphere::SphereState;
+use crate::contact::narrow_phase::{self, ListEntries};
 use crate::contact::pair_batch::{PairBatch, PairConstants, SphereArrays};
 use crate::contact::{contact_sphere_wall as sphere_wall, hertz_mindlin, ContactHistory, PairLaw};
 use crate::counters::{timed, Counters};
@@ -12,7 +13,6 @@ use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::slices::for_each_task;
 use crate::wall::WallSet;
-use rayon::prelude::*;
 
 /// Particles per parallel task in the wall stage.
 const BLOCK: usize = 1024;
@@ -115,11 +115,6 @@ pub fn pair_interactions(
         ..
     } = particles;
     let (pos, vel, omega, radius, mass, temp) = (&*pos, &*vel, &*omega, &*radius, &*mass, &*temp);
-    // the sums start from zero in one pass over the three accumulators
-    (&mut *force, &mut *torque, &mut *heat_flow)
-        .into_par_iter()
-        .with_min_len(4096)
-        .for_each(|(f, t, q)| (*f, *t, *q) = ([0.0; 3], [0.0; 3], 0.0));
     let NeighborList {
         offsets,
         neighbors: partners,
@@ -130,6 +125,12 @@ pub fn pair_interactions(
         ..
     } = neighbors;
     let layers = layer_start.len().saturating_sub(1);
+    if layers == 0 {
+        // no list yet: no pairs, and no task to start the sums below
+        force.fill([0.0; 3]);
+        torque.fill([0.0; 3]);
+        heat_flow.fill(0.0);
+    }
     let spheres = SphereArrays {
         pos,
         vel,
@@ -163,35 +164,33 @@ pub fn pair_interactions(
             let l = layer(k);
             let first_slot = layer_start[l] as usize;
             let first_entry = offsets[first_slot] as usize;
+            if phase == 0 {
+                // the first phase's pieces cover every slot once, and each task's are
+                // written by it alone and first: the sums start from zero here, where the
+                // task is about to use them, not in a pass of their own over memory
+                f.fill([0.0; 3]);
+                t.fill([0.0; 3]);
+                q.fill(0.0);
+            }
             let mut batch = PairBatch::default();
             // the owner's sums are kept apart and added once its contacts are done, as
             // each pair's partner sums are added in pair order: the order of every sum is
             // fixed by the list alone
             let mut owner = Owner::default();
-            let mut touching_pairs = 0;
-            for i in first_slot..layer_start[l + 1] as usize {
-                let (pos_i, radius_i) = (pos[i], radius[i]);
-                for e in offsets[i] as usize..offsets[i + 1] as usize {
-                    let j = partners[e] as usize;
-                    let delta = sub(pos_i, pos[j]);
-                    let local = e - first_entry;
-                    let Some(r2) = sphere_sphere::overlapping(delta, radius_i, radius[j]) else {
-                        if touch[local] {
-                            h[local] = ContactHistory::default();
-                            touch[local] = false;
-                        }
-                        continue;
-                    };
-                    touch[local] = true;
-                    touching_pairs += 1;
-                    if batch.push(i, j, local, delta, r2) {
-                        batch.evaluate(&constants, &spheres, h);
-                        owner.scatter(&mut batch, (f, t, q), first_slot);
-                    }
-                }
-            }
-            batch.evaluate(&constants, &spheres, h);
-            owner.scatter(&mut batch, (f, t, q), first_slot);
+            let entries = ListEntries {
+                slots: first_slot..layer_start[l + 1] as usize,
+                offsets,
+                partners,
+                first_entry,
+            };
+            let mut evaluate = |batch: &mut PairBatch, h: &mut [ContactHistory]| {
+                batch.evaluate(&constants, &spheres, h);
+                owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
+            };
+            let touching_pairs =
+                narrow_phase::scan(&entries, pos, radius, touch, h, &mut batch, &mut evaluate);
+            // the batch holds fewer than a full batch's contacts now: one evaluation
+            evaluate(&mut batch, h);
             owner.add_to((f, t, q), first_slot);
             touching_pairs
         };
@@ -233,7 +232,7 @@ impl Owner {
         (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]),
         first_slot: usize,
     ) {
-        for l in 0..batch.len() {
+        for l in 0..batch.ready() {
             let (i, j, r) = batch.response(l);
             if i != self.slot {
                 self.add_to((&mut *f, &mut *t, &mut *q), first_slot);
@@ -247,7 +246,7 @@ impl Owner {
             t[jl] = add(t[jl], r.torque_partner);
             q[jl] -= r.heat_flow;
         }
-        batch.clear();
+        batch.consume();
     }
 
     /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.

@@ -3,6 +3,7 @@
 pub mod contact_sphere_sphere;
 pub mod contact_sphere_wall;
 pub mod hertz_mindlin;
+pub mod narrow_phase;
 pub mod pair_batch;
 pub mod rolling;
 

@@ -15,6 +15,9 @@ use crate::math::*;
 
 /// Contacts evaluated together: two AVX-512 vectors of doubles.
 pub const LANES: usize = 16;
+/// Contacts a batch can hold: a full batch and one vector of pushes beyond it (the vector
+/// scan pushes up to 8 at once).
+const CAPACITY: usize = LANES + 8;
 
 /// The per-particle arrays the law reads.
 #[derive(Clone, Copy)]
@@ -37,15 +40,18 @@ pub struct PairResponse {
     pub heat_flow: f64,
 }
 
-/// Up to [`LANES`] touching pairs, one array per field so each lane loop reads a vector.
+/// Touching pairs, one array per field so each lane loop reads a vector; the first
+/// [`LANES`] are evaluated together.
 pub struct PairBatch {
     len: usize,
-    owner: [u32; LANES],
-    partner: [u32; LANES],
+    /// Contacts evaluated by the last `evaluate` (the first ones pushed).
+    ready: usize,
+    owner: [u32; CAPACITY],
+    partner: [u32; CAPACITY],
     /// Index of the pair's history in the history slice handed to `evaluate`.
-    entry: [u32; LANES],
-    delta: [[f64; LANES]; 3],
-    r2: [f64; LANES],
+    entry: [u32; CAPACITY],
+    delta: [[f64; CAPACITY]; 3],
+    r2: [f64; CAPACITY],
     lanes: Lanes,
 }
 
@@ -73,11 +79,12 @@ impl Default for PairBatch {
         let zero = [0.0; LANES];
         Self {
             len: 0,
-            owner: [0; LANES],
-            partner: [0; LANES],
-            entry: [0; LANES],
-            delta: [zero; 3],
-            r2: zero,
+            ready: 0,
+            owner: [0; CAPACITY],
+            partner: [0; CAPACITY],
+            entry: [0; CAPACITY],
+            delta: [[0.0; CAPACITY]; 3],
+            r2: [0.0; CAPACITY],
             lanes: Lanes {
                 vel_i: [zero; 3],
                 vel_j: [zero; 3],
@@ -130,23 +137,69 @@ impl PairBatch {
         }
         self.r2[l] = r2;
         self.len += 1;
-        self.len == LANES
+        self.len >= LANES
     }
 
-    /// Evaluates the batch's contacts and advances their histories in `history`; the
-    /// responses are then read with [`PairBatch::response`] in the order the contacts were
-    /// pushed, and [`PairBatch::clear`] empties the batch.
+    /// Adds the lanes of `hit` among 8 entries of `owner` (partner slots, history indices,
+    /// centre distances `delta` and their squared lengths `r2`), keeping their order; true
+    /// when the batch is full. The batch must not be full before.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512vl")]
+    #[inline]
+    #[allow(clippy::too_many_arguments)]
+    pub fn push_lanes(
+        &mut self,
+        hit: std::arch::x86_64::__mmask8,
+        owner: usize,
+        partner: std::arch::x86_64::__m256i,
+        entry: std::arch::x86_64::__m256i,
+        delta: [std::arch::x86_64::__m512d; 3],
+        r2: std::arch::x86_64::__m512d,
+    ) -> bool {
+        use std::arch::x86_64::*;
+        let l = self.len;
+        debug_assert!(l < LANES);
+        // every store writes 8 lanes (room is left for them); only the hits count, and the
+        // next push or evaluation overwrites the rest
+        // SAFETY: l + 8 <= CAPACITY, so each store stays inside its array
+        unsafe {
+            let stored = |a: &mut [u32; CAPACITY]| a.as_mut_ptr().add(l) as *mut __m256i;
+            _mm256_storeu_si256(stored(&mut self.owner), _mm256_set1_epi32(owner as i32));
+            _mm256_storeu_si256(
+                stored(&mut self.partner),
+                _mm256_maskz_compress_epi32(hit, partner),
+            );
+            _mm256_storeu_si256(
+                stored(&mut self.entry),
+                _mm256_maskz_compress_epi32(hit, entry),
+            );
+            for (a, d) in self.delta.iter_mut().zip(delta) {
+                _mm512_storeu_pd(a.as_mut_ptr().add(l), _mm512_maskz_compress_pd(hit, d));
+            }
+            _mm512_storeu_pd(
+                self.r2.as_mut_ptr().add(l),
+                _mm512_maskz_compress_pd(hit, r2),
+            );
+        }
+        self.len += hit.count_ones() as usize;
+        self.len >= LANES
+    }
+
+    /// Evaluates the first [`LANES`] contacts pushed (all if fewer) and advances their
+    /// histories in `history`; their responses are then read with [`PairBatch::response`]
+    /// in the order they were pushed, and [`PairBatch::consume`] removes them.
     pub fn evaluate(
         &mut self,
         constants: &PairConstants,
         spheres: &SphereArrays,
         history: &mut [ContactHistory],
     ) {
-        let n = self.len;
+        let n = self.len.min(LANES);
+        self.ready = n;
         if n == 0 {
             return;
         }
-        self.gather(constants, spheres, history);
+        self.gather(n, constants, spheres, history);
         run_lanes(&mut self.lanes, &self.delta, &self.r2, n, constants);
         let lanes = &self.lanes;
         for l in 0..n {
@@ -161,6 +214,12 @@ impl PairBatch {
     #[inline(always)]
     pub fn len(&self) -> usize {
         self.len
+    }
+
+    /// Contacts evaluated by the last [`PairBatch::evaluate`].
+    #[inline(always)]
+    pub fn ready(&self) -> usize {
+        self.ready
     }
 
     #[inline(always)]
@@ -181,19 +240,53 @@ impl PairBatch {
         (self.owner[l] as usize, self.partner[l] as usize, response)
     }
 
-    pub fn clear(&mut self) {
-        self.len = 0;
+    /// Owner, partner, history index, `delta` and `r2` of the `l`-th contact pushed.
+    #[cfg(test)]
+    pub(crate) fn pushed(&self, l: usize) -> (u32, u32, u32, Vec3, f64) {
+        assert!(l < self.len);
+        let delta = lane3(&self.delta, l);
+        (
+            self.owner[l],
+            self.partner[l],
+            self.entry[l],
+            delta,
+            self.r2[l],
+        )
     }
 
-    /// Copies every lane's sphere states and history into the lane arrays.
+    /// Removes the evaluated contacts; those pushed after them move to the front.
+    pub fn consume(&mut self) {
+        self.skip(self.ready);
+    }
+
+    /// Removes the first `ready` contacts pushed.
+    pub(crate) fn skip(&mut self, ready: usize) {
+        let len = self.len;
+        assert!(ready <= len);
+        if len > ready {
+            let rest = ready..len;
+            self.owner.copy_within(rest.clone(), 0);
+            self.partner.copy_within(rest.clone(), 0);
+            self.entry.copy_within(rest.clone(), 0);
+            for d in &mut self.delta {
+                d.copy_within(rest.clone(), 0);
+            }
+            self.r2.copy_within(rest, 0);
+        }
+        self.len = len - ready;
+        self.ready = 0;
+    }
+
+    /// Copies the first `n` lanes' sphere states and histories into the lane arrays.
     fn gather(
         &mut self,
+        n: usize,
         constants: &PairConstants,
         spheres: &SphereArrays,
         history: &[ContactHistory],
     ) {
         let lanes = &mut self.lanes;
-        for l in 0..self.len {
+        for l in 0..n {
             let (i, j) = (self.owner[l] as usize, self.partner[l] as usize);
             let h = &history[self.entry[l] as usize];
             for a in 0..3 {
@@ -219,15 +312,15 @@ impl PairBatch {
 
 /// Lane `l` of three lane arrays.
 #[inline(always)]
-fn lane3(a: &[[f64; LANES]; 3], l: usize) -> Vec3 {
+fn lane3<const N: usize>(a: &[[f64; N]; 3], l: usize) -> Vec3 {
     [a[0][l], a[1][l], a[2][l]]
 }
 
 /// Runs the law over the first `n` lanes with the widest vectors this CPU has.
 fn run_lanes(
     lanes: &mut Lanes,
-    delta: &[[f64; LANES]; 3],
-    r2: &[f64; LANES],
+    delta: &[[f64; CAPACITY]; 3],
+    r2: &[f64; CAPACITY],
     n: usize,
     constants: &PairConstants,
 ) {
@@ -265,8 +358,8 @@ macro_rules! law_lanes_for {
         #[target_feature(enable = $feature)]
         fn $name<const MODEL: u8>(
             lanes: &mut Lanes,
-            delta: &[[f64; LANES]; 3],
-            r2: &[f64; LANES],
+            delta: &[[f64; CAPACITY]; 3],
+            r2: &[f64; CAPACITY],
             n: usize,
             constants: &PairConstants,
         ) {
@@ -284,8 +377,8 @@ law_lanes_for!(lanes_avx2, "avx2");
 #[inline(always)]
 fn law_lanes<const MODEL: u8>(
     lanes: &mut Lanes,
-    delta: &[[f64; LANES]; 3],
-    r2: &[f64; LANES],
+    delta: &[[f64; CAPACITY]; 3],
+    r2: &[f64; CAPACITY],
     n: usize,
     constants: &PairConstants,
 ) {
@@ -314,7 +407,7 @@ fn law_lanes<const MODEL: u8>(
         let c = sphere_sphere::kinematics(
             &si,
             &sj,
-            lane3(delta),
+            [delta[0][l], delta[1][l], delta[2][l]],
             r2[l],
             (lanes.r_eff[l], lanes.m_eff[l]),
         );
@@ -447,8 +540,8 @@ mod tests {
                 let mut batch = PairBatch::default();
                 let mut evaluate = |batch: &mut PairBatch| {
                     batch.evaluate(&constants, &spheres, &mut batched);
-                    responses.extend((0..batch.len()).map(|l| batch.response(l)));
-                    batch.clear();
+                    responses.extend((0..batch.ready()).map(|l| batch.response(l)));
+                    batch.consume();
                 };
                 for p in 0..start.len() {
                     let delta = sub(pos[2 * p], pos[2 * p + 1]);

@@ -1,0 +1,307 @@
+//! The pair stage's narrow phase: which entries of the half list touch now. Touching pairs
+//! go into a [`PairBatch`]; an entry that stopped touching gets its history cleared.
+//!
+//! About one entry in three touches, in no pattern the branch predictor can learn, so the
+//! scan is worth doing without a branch per entry: on CPUs with AVX-512 eight entries are
+//! tested at once and their hits compressed into the batch. Both scans push the same pairs
+//! in the same order (and compute the same bits), so the results do not depend on the CPU.
+
+use super::contact_sphere_sphere::overlapping;
+use super::pair_batch::PairBatch;
+use super::ContactHistory;
+use crate::math::*;
+use std::ops::Range;
+
+/// The list entries of a run of slots, and where their histories begin.
+#[derive(Clone)]
+pub struct ListEntries<'a> {
+    pub slots: Range<usize>,
+    /// Entries of slot `i` are `offsets[i]..offsets[i + 1]` of `partners`.
+    pub offsets: &'a [u32],
+    pub partners: &'a [u32],
+    /// Entry `e`'s history and touching flag are at `e - first_entry` of the slices the scan
+    /// is given.
+    pub first_entry: usize,
+}
+
+/// Scans the entries: each touching pair is pushed into `batch`, and `full(batch, history)`
+/// is called whenever the batch is full (the caller evaluates it and consumes what it
+/// evaluated). Entries that stopped touching get a zero history. Returns the touching
+/// pairs; the batch may hold some of them when it returns.
+#[inline(always)]
+pub fn scan(
+    entries: &ListEntries,
+    pos: &[Vec3],
+    radius: &[f64],
+    touching: &mut [bool],
+    history: &mut [ContactHistory],
+    batch: &mut PairBatch,
+    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+        {
+            // SAFETY: the CPU has the three features, checked just above
+            return unsafe { scan_avx512(entries, pos, radius, touching, history, batch, full) };
+        }
+    }
+    scan_entries(entries, pos, radius, touching, history, batch, full)
+}
+
+/// One entry at a time.
+#[inline(always)]
+fn scan_entries(
+    entries: &ListEntries,
+    pos: &[Vec3],
+    radius: &[f64],
+    touch: &mut [bool],
+    history: &mut [ContactHistory],
+    batch: &mut PairBatch,
+    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+) -> u64 {
+    let ListEntries {
+        slots,
+        offsets,
+        partners,
+        first_entry,
+    } = entries;
+    let mut touching = 0;
+    for i in slots.clone() {
+        let (pos_i, radius_i) = (pos[i], radius[i]);
+        for e in offsets[i] as usize..offsets[i + 1] as usize {
+            let j = partners[e] as usize;
+            let delta = sub(pos_i, pos[j]);
+            let local = e - first_entry;
+            let Some(r2) = overlapping(delta, radius_i, radius[j]) else {
+                if touch[local] {
+                    history[local] = ContactHistory::default();
+                    touch[local] = false;
+                }
+                continue;
+            };
+            touch[local] = true;
+            touching += 1;
+            if batch.push(i, j, local, delta, r2) {
+                full(batch, history);
+            }
+        }
+    }
+    touching
+}
+
+/// Eight entries at a time: the partners' positions and radii are gathered, the overlap
+/// test gives a mask, and the hits are compressed into the batch. The arithmetic is
+/// `overlapping`'s, operation for operation (no fused multiply-add), so the pairs and their
+/// `delta` and `r2` are those of [`scan_entries`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw")]
+fn scan_avx512(
+    entries: &ListEntries,
+    pos: &[Vec3],
+    radius: &[f64],
+    touch: &mut [bool],
+    history: &mut [ContactHistory],
+    batch: &mut PairBatch,
+    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+) -> u64 {
+    use std::arch::x86_64::*;
+    let ListEntries {
+        slots,
+        offsets,
+        partners,
+        first_entry,
+    } = entries;
+    let coordinates = pos.as_ptr() as *const f64;
+    let last = offsets[slots.end] as usize;
+    // the masked loads and stores below rely on it (offsets do not decrease)
+    assert!(last <= partners.len() && last - first_entry <= touch.len());
+    assert!(pos.len() == radius.len() && pos.len() <= i32::MAX as usize / 3);
+    let slot_count = _mm256_set1_epi32(pos.len() as i32);
+    let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let mut touching = 0;
+    for i in slots.clone() {
+        let (pos_i, radius_i) = (pos[i], radius[i]);
+        let xi = pos_i.map(|x| _mm512_set1_pd(x));
+        let ri = _mm512_set1_pd(radius_i);
+        let end = offsets[i + 1] as usize;
+        let mut e = offsets[i] as usize;
+        while e < end {
+            let valid: __mmask8 = if end - e >= 8 {
+                0xff
+            } else {
+                (1u8 << (end - e)) - 1
+            };
+            let local = e - first_entry;
+            // SAFETY: the masked loads and stores reach only the valid lanes, entries
+            // e..end, inside `partners` and (shifted by first_entry) `touch` (asserted above);
+            // the gathers read the valid lanes' partner slots, checked below pos.len()
+            let (j, delta, r2, hit, was) = unsafe {
+                let j = _mm256_maskz_loadu_epi32(valid, partners.as_ptr().add(e) as *const i32);
+                // a partner outside the arrays would make the gathers read past them
+                let outside = _mm256_mask_cmpge_epu32_mask(valid, j, slot_count);
+                assert!(outside == 0, "a list entry of slot {i} names no particle");
+                let j3 = _mm256_add_epi32(_mm256_add_epi32(j, j), j);
+                let zero = _mm512_setzero_pd();
+                let delta: [__m512d; 3] = std::array::from_fn(|a| {
+                    let xj = _mm512_mask_i32gather_pd::<8>(zero, valid, j3, coordinates.add(a));
+                    _mm512_sub_pd(xi[a], xj)
+                });
+                let rj = _mm512_mask_i32gather_pd::<8>(zero, valid, j, radius.as_ptr());
+                let r2 = _mm512_add_pd(
+                    _mm512_add_pd(
+                        _mm512_mul_pd(delta[0], delta[0]),
+                        _mm512_mul_pd(delta[1], delta[1]),
+                    ),
+                    _mm512_mul_pd(delta[2], delta[2]),
+                );
+                let radsum = _mm512_add_pd(ri, rj);
+                let reach = _mm512_mul_pd(radsum, radsum);
+                let hit = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(valid, r2, reach);
+                let flags = touch.as_mut_ptr().add(local) as *mut i8;
+                let was = _mm_maskz_loadu_epi8(valid as __mmask16, flags);
+                let was = _mm_test_epi8_mask(was, was) as __mmask8;
+                _mm_mask_storeu_epi8(
+                    flags,
+                    valid as __mmask16,
+                    _mm_maskz_set1_epi8(hit as __mmask16, 1),
+                );
+                (j, delta, r2, hit, was)
+            };
+            // contacts that just ended: rare, one branch per group of eight
+            let mut ended = was & !hit;
+            while ended != 0 {
+                history[local + ended.trailing_zeros() as usize] = ContactHistory::default();
+                ended &= ended - 1;
+            }
+            if hit != 0 {
+                touching += u64::from(hit.count_ones());
+                let entry = _mm256_add_epi32(_mm256_set1_epi32(local as i32), lane);
+                if batch.push_lanes(hit, i, j, entry, delta, r2) {
+                    full(batch, history);
+                }
+            }
+            e += 8;
+        }
+    }
+    touching
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::insertion::uniform;
+    use rand_xoshiro::rand_core::SeedableRng;
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    type Pushed = Vec<(u32, u32, u32, [u64; 3], u64)>;
+
+    /// What a scan did: the pairs pushed in order (bits of `delta` and `r2`), the touching
+    /// flags and histories after it, and the count it returned.
+    fn outcome(
+        vector: bool,
+        entries: &ListEntries,
+        pos: &[Vec3],
+        radius: &[f64],
+        touching: &[bool],
+        history: &[ContactHistory],
+    ) -> (Pushed, Vec<bool>, Vec<ContactHistory>, u64) {
+        let (mut touch, mut hist) = (touching.to_vec(), history.to_vec());
+        let mut pushed = Pushed::new();
+        let mut take = |batch: &mut PairBatch, _: &mut [ContactHistory]| {
+            // what `evaluate` would take: the first LANES pushed
+            let n = batch.len().min(super::super::pair_batch::LANES);
+            for l in 0..n {
+                let (i, j, e, d, r2) = batch.pushed(l);
+                pushed.push((i, j, e, d.map(f64::to_bits), r2.to_bits()));
+            }
+            batch.skip(n);
+        };
+        let mut batch = PairBatch::default();
+        let count = if vector {
+            assert!(
+                std::arch::is_x86_feature_detected!("avx512f")
+                    && std::arch::is_x86_feature_detected!("avx512vl")
+                    && std::arch::is_x86_feature_detected!("avx512bw")
+            );
+            // SAFETY: the features were checked just above
+            unsafe {
+                scan_avx512(
+                    entries, pos, radius, &mut touch, &mut hist, &mut batch, &mut take,
+                )
+            }
+        } else {
+            scan_entries(
+                entries, pos, radius, &mut touch, &mut hist, &mut batch, &mut take,
+            )
+        };
+        take(&mut batch, &mut []);
+        assert_eq!(batch.len(), 0);
+        (pushed, touch, hist, count)
+    }
+
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn the_vector_scan_pushes_the_pairs_and_bits_of_the_entry_by_entry_scan() {
+        if !std::arch::is_x86_feature_detected!("avx512bw")
+            || !std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            eprintln!("no AVX-512 on this CPU: the vector scan is not used here");
+            return;
+        }
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+        let mut u = move || uniform(&mut rng);
+        // spheres of unequal radii in a small box: about a third of the entries touch
+        let n = 400;
+        let pos: Vec<Vec3> = (0..n)
+            .map(|_| [0.05 * u(), 0.05 * u(), 0.05 * u()])
+            .collect();
+        let radius: Vec<f64> = (0..n).map(|_| 0.004 + 0.002 * u()).collect();
+        // 0 to 19 entries per slot: every tail length of the 8-wide groups, and several
+        // batches filled in the middle of a slot's entries
+        let (mut offsets, mut partners) = (vec![0u32], vec![]);
+        for _ in 0..n {
+            let count = (19.0 * u()) as usize;
+            partners.extend((0..count).map(|_| ((n as f64 * u()) as u32).min(n as u32 - 1)));
+            offsets.push(partners.len() as u32);
+        }
+        // slots 37.. of a task whose histories start at its first entry
+        let first_entry = offsets[37] as usize;
+        let entries = ListEntries {
+            slots: 37..n,
+            offsets: &offsets,
+            partners: &partners,
+            first_entry,
+        };
+        let local = partners.len() - first_entry;
+        let touching: Vec<bool> = (0..local).map(|_| u() < 0.4).collect();
+        let history: Vec<ContactHistory> = touching
+            .iter()
+            .map(|&t| {
+                let s = if t { 1e-4 * (1.0 + u()) } else { 0.0 };
+                ContactHistory {
+                    shear: [s, -s, 0.5 * s],
+                    roll: [0.1 * s; 3],
+                }
+            })
+            .collect();
+
+        let one = outcome(false, &entries, &pos, &radius, &touching, &history);
+        let eight = outcome(true, &entries, &pos, &radius, &touching, &history);
+        assert_eq!(one.0, eight.0, "pushed pairs");
+        assert_eq!(one.1, eight.1, "touching flags");
+        assert_eq!(one.2, eight.2, "histories");
+        assert_eq!(one.3, eight.3, "count");
+        // the sample exercises every path: hits, misses, contacts that ended and several
+        // full batches
+        let ended = (0..local).filter(|&e| touching[e] && !one.1[e]).count();
+        let hits = one.1.iter().filter(|&&t| t).count();
+        assert!(
+            ended > 0 && hits > 3 * 16 && hits < local,
+            "{ended} ended, {hits} of {local}"
+        );
+        assert_eq!(one.3 as usize, hits);
+    }
+}
