@@ -13,9 +13,13 @@ use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::slices::for_each_task;
 use crate::wall::WallSet;
+use std::ops::Range;
 
 /// Particles per parallel task in the wall stage.
 const BLOCK: usize = 1024;
+/// Particles per chunk of the pair stage's layers: a chunk's state and lists stay in the
+/// cache between its two phases.
+const CHUNK: u32 = 16384;
 
 /// Everything constant during a step.
 #[derive(Debug, Clone, PartialEq)]
@@ -93,10 +97,10 @@ impl Pipeline {
 /// Sphere–sphere forces, torques and conduction, each pair evaluated once from the half list.
 ///
 /// Layer `l` of the cell grid owns the pairs of its particles, whose partners lie in layer
-/// `l` or `l + 1`, so it writes only those two layers. The even layers run in parallel, then
-/// the odd ones: no two tasks write the same particle, and every particle receives its
-/// contributions in an order fixed by the list alone, so the sums do not depend on the
-/// thread count. Returns the touching pairs counted from both sides.
+/// `l` or `l + 1`, so it writes only those two layers. Even layers run in parallel, then
+/// the odd ones (chunk by chunk, below): no two tasks write the same particle, and every
+/// particle receives its contributions in an order fixed by the list alone, so the sums do
+/// not depend on the thread count. Returns the touching pairs counted from both sides.
 pub fn pair_interactions(
     params: &StepParams,
     particles: &mut ParticleSet,
@@ -145,10 +149,9 @@ pub fn pair_interactions(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
-    let mut pairs = 0;
-    for phase in 0..2 {
-        // task k owns layer l = phase + 2k: it writes the slots of l and l + 1 and the
-        // entries of l (its pieces reach the next task's start; it touches only those)
+    // task k of a phase owns layer l = phase + 2k: it writes the slots of l and l + 1 and
+    // the entries of l (its pieces reach the next task's start; it touches only those)
+    let mut run = |phase: usize, tasks: Range<usize>| {
         let layer = |k: usize| phase + 2 * k;
         let start = |k: usize| {
             let s = layer_start[layer(k)] as usize;
@@ -159,18 +162,18 @@ pub fn pair_interactions(
             (&mut force[..], &mut torque[..]),
             (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
         );
-        let tasks = 0..layers.saturating_sub(phase).div_ceil(2);
         let work = |k: usize, ((f, t), (q, (h, touch))): Accumulators| {
             let l = layer(k);
             let first_slot = layer_start[l] as usize;
             let first_entry = offsets[first_slot] as usize;
             if phase == 0 {
-                // the first phase's pieces cover every slot once, and each task's are
-                // written by it alone and first: the sums start from zero here, where the
-                // task is about to use them, not in a pass of their own over memory
-                f.fill([0.0; 3]);
-                t.fill([0.0; 3]);
-                q.fill(0.0);
+                // an even task is the first to write its two layers: their sums start
+                // from zero here, where the task is about to use them, not in a pass of
+                // their own over memory
+                let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
+                f[..written].fill([0.0; 3]);
+                t[..written].fill([0.0; 3]);
+                q[..written].fill(0.0);
             }
             let mut batch = PairBatch::default();
             // the owner's sums are kept apart and added once its contacts are done, as
@@ -194,7 +197,31 @@ pub fn pair_interactions(
             owner.add_to((f, t, q), first_slot);
             touching_pairs
         };
-        pairs += for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work);
+        for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
+    };
+    // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
+    // layer of each, and each particle's sums keep that order). Rather than all even
+    // tasks, then all odd ones, which reads every layer from memory twice once the state
+    // outgrows the cache, the layers go in chunks of about CHUNK particles: a chunk's even
+    // tasks, then the odd tasks whose two even neighbours are done; the chunk's last odd
+    // layer waits for the next chunk's first even one. Same tasks, same order of every sum.
+    let odd_tasks = layers.saturating_sub(1).div_ceil(2);
+    let (mut pairs, mut first, mut odd_done) = (0, 0, 0);
+    while first < layers {
+        let mut end = first + 2;
+        while end < layers && (layer_start[end] - layer_start[first]) < CHUNK {
+            end += 2;
+        }
+        let end = end.min(layers);
+        pairs += run(0, first / 2..end.div_ceil(2));
+        let odd_ready = if end == layers {
+            odd_tasks
+        } else {
+            end / 2 - 1
+        };
+        pairs += run(1, odd_done..odd_ready);
+        odd_done = odd_ready;
+        first = end;
     }
     2 * pairs
 }
