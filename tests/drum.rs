@@ -194,6 +194,57 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
     }
 }
 
+/// The pair stage takes the layers chunk by chunk (even tasks, then the odd ones whose even
+/// neighbours are done); the chunk size changes the schedule, not a bit of the results.
+#[test]
+fn the_pair_stage_gives_the_same_bits_whatever_its_chunks() {
+    use recorder::pipeline::pair_interactions_in_chunks;
+
+    let before = turning_small_drum(2000, true);
+    let layers = before.neighbors.layer_start.len() - 1;
+    assert!(layers >= 8, "{layers} layers: too few for several chunks");
+    let stage = |chunk: u32| {
+        let mut after = before.clone();
+        let pairs = pair_interactions_in_chunks(
+            &after.params,
+            &mut after.particles,
+            &mut after.neighbors,
+            chunk,
+        );
+        let p = &after.particles;
+        let bits = |v: &[[f64; 3]]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
+        let springs = after
+            .neighbors
+            .history
+            .iter()
+            .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
+            .collect::<Vec<_>>();
+        let heat = p.heat_flow.iter().map(|q| q.to_bits()).collect::<Vec<_>>();
+        let touching = after.neighbors.touching.clone();
+        (
+            pairs,
+            bits(&p.force),
+            bits(&p.torque),
+            heat,
+            springs,
+            touching,
+        )
+    };
+    // one chunk for the whole drum, about two layers per chunk, and one in between
+    let whole = stage(u32::MAX);
+    assert!(
+        whole.0 > 2000,
+        "the bed should be in contact: {} entries touch",
+        whole.0
+    );
+    for chunk in [1, 300, 900] {
+        assert!(
+            stage(chunk) == whole,
+            "chunks of {chunk} particles changed the pair stage"
+        );
+    }
+}
+
 /// A rebuild re-sorts the particles and rebuilds the lists; every open contact keeps its
 /// springs, seen from whichever particle now owns the entry.
 #[test]

@@ -106,6 +106,17 @@ pub fn pair_interactions(
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
 ) -> u64 {
+    pair_interactions_in_chunks(params, particles, neighbors, CHUNK)
+}
+
+/// [`pair_interactions`] with the layers taken in chunks of about `chunk` particles (the
+/// results do not depend on it).
+pub fn pair_interactions_in_chunks(
+    params: &StepParams,
+    particles: &mut ParticleSet,
+    neighbors: &mut NeighborList,
+    chunk: u32,
+) -> u64 {
     let ParticleSet {
         pos,
         vel,
@@ -202,14 +213,14 @@ pub fn pair_interactions(
     // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
     // layer of each, and each particle's sums keep that order). Rather than all even
     // tasks, then all odd ones, which reads every layer from memory twice once the state
-    // outgrows the cache, the layers go in chunks of about CHUNK particles: a chunk's even
+    // outgrows the cache, the layers go in chunks of about `chunk` particles: a chunk's even
     // tasks, then the odd tasks whose two even neighbours are done; the chunk's last odd
     // layer waits for the next chunk's first even one. Same tasks, same order of every sum.
     let odd_tasks = layers.saturating_sub(1).div_ceil(2);
     let (mut pairs, mut first, mut odd_done) = (0, 0, 0);
     while first < layers {
         let mut end = first + 2;
-        while end < layers && (layer_start[end] - layer_start[first]) < CHUNK {
+        while end < layers && (layer_start[end] - layer_start[first]) < chunk {
             end += 2;
         }
         let end = end.min(layers);
