@@ -245,42 +245,6 @@ fn the_pair_stage_gives_the_same_bits_whatever_its_chunks() {
     }
 }
 
-/// A step hands each chunk's particles to the wall stage and the second half kick as soon
-/// as their pair sums are complete; whole steps, rebuilds included, give the same bits
-/// whatever the chunks.
-#[test]
-fn steps_give_the_same_bits_whatever_the_chunks() {
-    let before = turning_small_drum(1000, true);
-    let run = |chunk: u32| {
-        let mut sim = before.clone();
-        sim.pipeline.chunk = chunk;
-        sim.run(300, 1000, &mut |_| {}).unwrap();
-        let p = &sim.particles;
-        let bits = |v: &[[f64; 3]]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
-        let temp = p.temp.iter().map(|t| t.to_bits()).collect::<Vec<_>>();
-        let rebuilds = sim.neighbors.rebuilds;
-        (
-            bits(&p.pos),
-            bits(&p.vel),
-            bits(&p.omega),
-            temp,
-            p.id.clone(),
-            rebuilds,
-        )
-    };
-    let whole = run(u32::MAX);
-    assert!(
-        whole.5 > before.neighbors.rebuilds,
-        "no rebuild in 300 steps"
-    );
-    for chunk in [1, 300] {
-        assert!(
-            run(chunk) == whole,
-            "chunks of {chunk} particles changed the steps"
-        );
-    }
-}
-
 /// A rebuild re-sorts the particles and rebuilds the lists; every open contact keeps its
 /// springs, seen from whichever particle now owns the entry.
 #[test]

@@ -3,7 +3,6 @@
 use crate::math::*;
 use crate::particles::ParticleSet;
 use rayon::prelude::*;
-use std::ops::Range;
 
 /// Moment of inertia of a solid sphere is `INERTIA · m R²`.
 const INERTIA: f64 = 0.4;
@@ -64,18 +63,6 @@ pub fn initial_integrate(
 /// Second half kick `v += dt/2 (F/m + g)`, `ω += dt/2 T/I`, and forward Euler on the heat
 /// flows of this step, `T += dt Q / (m c)`.
 pub fn final_integrate(p: &mut ParticleSet, dt: f64, gravity: Vec3, heat_capacity: f64) {
-    let n = p.len();
-    final_integrate_in(p, dt, gravity, heat_capacity, 0..n);
-}
-
-/// [`final_integrate`] of the slots `slots` only.
-pub fn final_integrate_in(
-    p: &mut ParticleSet,
-    dt: f64,
-    gravity: Vec3,
-    heat_capacity: f64,
-    slots: Range<usize>,
-) {
     let half = 0.5 * dt;
     let ParticleSet {
         vel,
@@ -88,19 +75,14 @@ pub fn final_integrate_in(
         heat_flow,
         ..
     } = p;
-    let s = slots;
-    (
-        &mut vel[s.clone()],
-        &mut omega[s.clone()],
-        &mut temp[s.clone()],
-    )
+    (vel, omega, temp)
         .into_par_iter()
         .zip((
-            force[s.clone()].par_iter(),
-            torque[s.clone()].par_iter(),
-            radius[s.clone()].par_iter(),
-            mass[s.clone()].par_iter(),
-            heat_flow[s].par_iter(),
+            force.par_iter(),
+            torque.par_iter(),
+            radius.par_iter(),
+            mass.par_iter(),
+            heat_flow.par_iter(),
         ))
         .with_min_len(MIN_TASK)
         .for_each(|((v, w, temp), (f, t, r, m, q))| {

@@ -14,7 +14,6 @@ use crate::particles::ParticleSet;
 use crate::slices::for_each_task;
 use crate::wall::WallSet;
 use std::ops::Range;
-use std::time::Duration;
 
 /// Particles per parallel task in the wall stage.
 const BLOCK: usize = 1024;
@@ -44,13 +43,11 @@ pub struct ContactCount {
 #[derive(Debug, Clone)]
 pub struct Pipeline {
     pub grid: CellGrid,
-    /// Particles per chunk of the pair stage (the results do not depend on it).
-    pub chunk: u32,
 }
 
 impl Pipeline {
     pub fn new(grid: CellGrid) -> Self {
-        Self { grid, chunk: CHUNK }
+        Self { grid }
     }
 
     /// Advances the state by one `dt`.
@@ -77,27 +74,20 @@ impl Pipeline {
                 neighbors.rebuild(particles, &self.grid, walls);
             }
         });
-        // the wall contacts and the second half kick of a chunk's particles follow its pair
-        // tasks, while its state is still in the cache (each particle's sums and update
-        // are as if the stages ran one after the other over all particles)
-        let mut wall = 0;
-        let Counters {
-            pair,
-            wall: wall_time,
-            integrate: integrate_time,
-            ..
-        } = counters;
-        let mut finish = |p: &mut ParticleSet, list: &mut NeighborList, slots: Range<usize>| {
-            wall += timed(wall_time, || {
-                wall_interactions_in(params, p, list, walls, slots.clone())
-            });
-            timed(integrate_time, || {
-                let heat_capacity = params.conduction.heat_capacity;
-                integrate::final_integrate_in(p, params.dt, params.gravity, heat_capacity, slots)
-            });
-        };
-        let pair_entries =
-            chunked_interactions(params, particles, neighbors, self.chunk, pair, &mut finish);
+        let pair_entries = timed(&mut counters.pair, || {
+            pair_interactions(params, particles, neighbors)
+        });
+        let wall = timed(&mut counters.wall, || {
+            wall_interactions(params, particles, neighbors, walls)
+        });
+        timed(&mut counters.integrate, || {
+            integrate::final_integrate(
+                particles,
+                params.dt,
+                params.gravity,
+                params.conduction.heat_capacity,
+            );
+        });
         counters.steps += 1;
         counters.particle_steps += particles.len() as u64;
         ContactCount { pair_entries, wall }
@@ -108,10 +98,9 @@ impl Pipeline {
 ///
 /// Layer `l` of the cell grid owns the pairs of its particles, whose partners lie in layer
 /// `l` or `l + 1`, so it writes only those two layers. Even layers run in parallel, then
-/// the odd ones (chunk by chunk, see [`pair_interactions_in_chunks`]): no two tasks write
-/// the same particle, and every particle receives its contributions in an order fixed by
-/// the list alone, so the sums do not depend on the thread count. Returns the touching
-/// pairs counted from both sides.
+/// the odd ones (chunk by chunk, below): no two tasks write the same particle, and every
+/// particle receives its contributions in an order fixed by the list alone, so the sums do
+/// not depend on the thread count. Returns the touching pairs counted from both sides.
 pub fn pair_interactions(
     params: &StepParams,
     particles: &mut ParticleSet,
@@ -127,84 +116,6 @@ pub fn pair_interactions_in_chunks(
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
     chunk: u32,
-) -> u64 {
-    let mut pair_time = Duration::ZERO;
-    chunked_interactions(
-        params,
-        particles,
-        neighbors,
-        chunk,
-        &mut pair_time,
-        &mut |_, _, _| {},
-    )
-}
-
-/// The pair stage chunk by chunk; after each chunk, `finish` gets the slots whose pair sums
-/// are complete (every slot once, in order), while their state is still in the cache.
-///
-/// The odd task of layer `l` must follow the even tasks of `l - 1` and `l + 1` (it writes a
-/// layer of each, and each particle's sums keep that order). Rather than all even tasks,
-/// then all odd ones, which reads every layer from memory twice once the state outgrows the
-/// cache, the layers go in chunks of about `chunk` particles: a chunk's even tasks, then the
-/// odd tasks whose two even neighbours are done; the chunk's last odd layer waits for the
-/// next chunk's first even one. Same tasks, same order of every sum, whatever the chunks.
-fn chunked_interactions(
-    params: &StepParams,
-    particles: &mut ParticleSet,
-    neighbors: &mut NeighborList,
-    chunk: u32,
-    pair_time: &mut Duration,
-    finish: &mut impl FnMut(&mut ParticleSet, &mut NeighborList, Range<usize>),
-) -> u64 {
-    let n = particles.len();
-    let layers = neighbors.layer_start.len().saturating_sub(1);
-    if layers == 0 {
-        // no list yet: no pairs, and no task to start the sums
-        particles.force.fill([0.0; 3]);
-        particles.torque.fill([0.0; 3]);
-        particles.heat_flow.fill(0.0);
-        finish(particles, neighbors, 0..n);
-        return 0;
-    }
-    let odd_tasks = (layers - 1).div_ceil(2);
-    let (mut pairs, mut first, mut odd_done, mut finished) = (0, 0, 0, 0);
-    while first < layers {
-        let layer_start = &neighbors.layer_start;
-        let mut end = first + 2;
-        while end < layers && (layer_start[end] - layer_start[first]) < chunk {
-            end += 2;
-        }
-        let end = end.min(layers);
-        let odd_ready = if end == layers {
-            odd_tasks
-        } else {
-            end / 2 - 1
-        };
-        // all but the chunk's last layer, which the next chunk's first odd task still writes
-        let complete = if end == layers {
-            n
-        } else {
-            layer_start[end - 1] as usize
-        };
-        pairs += timed(pair_time, || {
-            pair_phase(params, particles, neighbors, 0, first / 2..end.div_ceil(2))
-                + pair_phase(params, particles, neighbors, 1, odd_done..odd_ready)
-        });
-        finish(particles, neighbors, finished..complete);
-        (odd_done, finished, first) = (odd_ready, complete, end);
-    }
-    2 * pairs
-}
-
-/// Runs the pair tasks `tasks` of a phase: task k owns layer l = phase + 2k, writes the
-/// slots of l and l + 1 and the entries of l (its pieces reach the next task's start; it
-/// touches only those). Returns the touching pairs.
-fn pair_phase(
-    params: &StepParams,
-    particles: &mut ParticleSet,
-    neighbors: &mut NeighborList,
-    phase: usize,
-    tasks: Range<usize>,
 ) -> u64 {
     let ParticleSet {
         pos,
@@ -228,8 +139,13 @@ fn pair_phase(
         uniform_pair,
         ..
     } = neighbors;
-    let (offsets, partners, layer_start) = (&*offsets, &*partners, &*layer_start);
-    let layers = layer_start.len() - 1;
+    let layers = layer_start.len().saturating_sub(1);
+    if layers == 0 {
+        // no list yet: no pairs, and no task to start the sums below
+        force.fill([0.0; 3]);
+        torque.fill([0.0; 3]);
+        heat_flow.fill(0.0);
+    }
     let spheres = SphereArrays {
         pos,
         vel,
@@ -244,51 +160,81 @@ fn pair_phase(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
-    let layer = |k: usize| phase + 2 * k;
-    let start = |k: usize| {
-        let s = layer_start[layer(k)] as usize;
-        let e = offsets[s] as usize;
-        ((s, s), (s, (e, e)))
+    // task k of a phase owns layer l = phase + 2k: it writes the slots of l and l + 1 and
+    // the entries of l (its pieces reach the next task's start; it touches only those)
+    let mut run = |phase: usize, tasks: Range<usize>| {
+        let layer = |k: usize| phase + 2 * k;
+        let start = |k: usize| {
+            let s = layer_start[layer(k)] as usize;
+            let e = offsets[s] as usize;
+            ((s, s), (s, (e, e)))
+        };
+        let arrays = (
+            (&mut force[..], &mut torque[..]),
+            (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
+        );
+        let work = |k: usize, ((f, t), (q, (h, touch))): Accumulators| {
+            let l = layer(k);
+            let first_slot = layer_start[l] as usize;
+            let first_entry = offsets[first_slot] as usize;
+            if phase == 0 {
+                // an even task is the first to write its two layers: their sums start
+                // from zero here, where the task is about to use them, not in a pass of
+                // their own over memory
+                let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
+                f[..written].fill([0.0; 3]);
+                t[..written].fill([0.0; 3]);
+                q[..written].fill(0.0);
+            }
+            let mut batch = PairBatch::default();
+            // the owner's sums are kept apart and added once its contacts are done, as
+            // each pair's partner sums are added in pair order: the order of every sum is
+            // fixed by the list alone
+            let mut owner = Owner::default();
+            let entries = ListEntries {
+                slots: first_slot..layer_start[l + 1] as usize,
+                offsets,
+                partners,
+                first_entry,
+            };
+            let mut evaluate = |batch: &mut PairBatch, h: &mut [ContactHistory]| {
+                batch.evaluate(&constants, &spheres, h);
+                owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
+            };
+            let touching_pairs =
+                narrow_phase::scan(&entries, pos, radius, touch, h, &mut batch, &mut evaluate);
+            // the batch holds fewer than a full batch's contacts now: one evaluation
+            evaluate(&mut batch, h);
+            owner.add_to((f, t, q), first_slot);
+            touching_pairs
+        };
+        for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
     };
-    let arrays = (
-        (&mut force[..], &mut torque[..]),
-        (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
-    );
-    let work = |k: usize, ((f, t), (q, (h, touch))): Accumulators| {
-        let l = layer(k);
-        let first_slot = layer_start[l] as usize;
-        let first_entry = offsets[first_slot] as usize;
-        if phase == 0 {
-            // an even task is the first to write its two layers: their sums start from
-            // zero here, where the task is about to use them, not in a pass of their own
-            let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
-            f[..written].fill([0.0; 3]);
-            t[..written].fill([0.0; 3]);
-            q[..written].fill(0.0);
+    // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
+    // layer of each, and each particle's sums keep that order). Rather than all even
+    // tasks, then all odd ones, which reads every layer from memory twice once the state
+    // outgrows the cache, the layers go in chunks of about `chunk` particles: a chunk's even
+    // tasks, then the odd tasks whose two even neighbours are done; the chunk's last odd
+    // layer waits for the next chunk's first even one. Same tasks, same order of every sum.
+    let odd_tasks = layers.saturating_sub(1).div_ceil(2);
+    let (mut pairs, mut first, mut odd_done) = (0, 0, 0);
+    while first < layers {
+        let mut end = first + 2;
+        while end < layers && (layer_start[end] - layer_start[first]) < chunk {
+            end += 2;
         }
-        let mut batch = PairBatch::default();
-        // the owner's sums are kept apart and added once its contacts are done, as each
-        // pair's partner sums are added in pair order: the order of every sum is fixed by
-        // the list alone
-        let mut owner = Owner::default();
-        let entries = ListEntries {
-            slots: first_slot..layer_start[l + 1] as usize,
-            offsets,
-            partners,
-            first_entry,
+        let end = end.min(layers);
+        pairs += run(0, first / 2..end.div_ceil(2));
+        let odd_ready = if end == layers {
+            odd_tasks
+        } else {
+            end / 2 - 1
         };
-        let mut evaluate = |batch: &mut PairBatch, h: &mut [ContactHistory]| {
-            batch.evaluate(&constants, &spheres, h);
-            owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
-        };
-        let touching_pairs =
-            narrow_phase::scan(&entries, pos, radius, touch, h, &mut batch, &mut evaluate);
-        // the batch holds fewer than a full batch's contacts now: one evaluation
-        evaluate(&mut batch, h);
-        owner.add_to((f, t, q), first_slot);
-        touching_pairs
-    };
-    for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
+        pairs += run(1, odd_done..odd_ready);
+        odd_done = odd_ready;
+        first = end;
+    }
+    2 * pairs
 }
 
 /// The sums of the particle whose contacts the pair stage is handing out.
@@ -368,18 +314,7 @@ pub fn wall_interactions(
     walls: &WallSet,
 ) -> u64 {
     let n = particles.len();
-    wall_interactions_in(params, particles, neighbors, walls, 0..n)
-}
-
-/// [`wall_interactions`] of the slots `slots` only.
-pub fn wall_interactions_in(
-    params: &StepParams,
-    particles: &mut ParticleSet,
-    neighbors: &mut NeighborList,
-    walls: &WallSet,
-    slots: Range<usize>,
-) -> u64 {
-    if walls.is_empty() || slots.is_empty() {
+    if walls.is_empty() || n == 0 {
         return 0;
     }
     let ParticleSet {
@@ -406,9 +341,9 @@ pub fn wall_interactions_in(
     let wall_index = &*wall_index;
     let dt = params.dt;
     let (law, heat) = (&params.particle_wall, &params.conduction);
-    // task b owns the slots of block b of the range and their wall candidates
+    // task b owns the slots of block b and their wall candidates
     let start = |b: usize| {
-        let first = slots.start + b * BLOCK;
+        let first = b * BLOCK;
         let w = wall_offsets[first] as usize;
         ((first, first), (first, (w, w)))
     };
@@ -420,11 +355,10 @@ pub fn wall_interactions_in(
         ),
     );
     let work = |b: usize, ((f, t), (q, (h, touch))): Accumulators| {
-        let first_slot = slots.start + b * BLOCK;
+        let first_slot = b * BLOCK;
         let first_entry = wall_offsets[first_slot] as usize;
         let mut touching = 0;
-        // the last block's pieces reach the arrays' end, past the range
-        for il in 0..BLOCK.min(slots.end - first_slot) {
+        for il in 0..f.len() {
             let i = first_slot + il;
             for e in wall_offsets[i] as usize..wall_offsets[i + 1] as usize {
                 let (w, local) = (wall_index[e] as usize, e - first_entry);
@@ -455,6 +389,6 @@ pub fn wall_interactions_in(
         }
         touching
     };
-    let tasks = 0..slots.len().div_ceil(BLOCK);
+    let tasks = 0..n.div_ceil(BLOCK);
     for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
 }
