@@ -192,6 +192,7 @@ fn scan_avx512(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::contact::pair_batch::LANES;
     use crate::insertion::uniform;
     use rand_xoshiro::rand_core::SeedableRng;
     use rand_xoshiro::Xoshiro256PlusPlus;
@@ -212,7 +213,7 @@ mod tests {
         let mut pushed = Pushed::new();
         let mut take = |batch: &mut PairBatch, _: &mut [ContactHistory]| {
             // what `evaluate` would take: the first LANES pushed
-            let n = batch.len().min(super::super::pair_batch::LANES);
+            let n = batch.len().min(LANES);
             for l in 0..n {
                 let (i, j, e, d, r2) = batch.pushed(l);
                 pushed.push((i, j, e, d.map(f64::to_bits), r2.to_bits()));
