@@ -214,7 +214,15 @@ fn damaged_checkpoints_and_journals_are_refused_with_clear_errors() {
     refused("cut short");
     std::fs::write(&ck, b"name = \"not a checkpoint\"\n").unwrap();
     refused("not a tdex checkpoint");
-    std::fs::write(&ck, good.replacen_bytes(b"checkpoint v1", b"checkpoint v9")).unwrap();
+    let version = format!(
+        "checkpoint v{}",
+        recorder::record::checkpoint::CHECKPOINT_VERSION
+    );
+    std::fs::write(
+        &ck,
+        good.replacen_bytes(version.as_bytes(), b"checkpoint v9"),
+    )
+    .unwrap();
     refused("checkpoint format v9");
 
     std::fs::write(&ck, &good).unwrap();

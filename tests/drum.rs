@@ -89,7 +89,7 @@ fn results_are_bit_identical_with_one_and_two_threads() {
     assert_eq!(tb(pa), tb(pb));
     let hist = |s: &Simulation| {
         s.neighbors
-            .history
+            .histories_by_entry()
             .iter()
             .map(|h| bits(&[h.shear, h.roll]))
             .collect::<Vec<_>>()
@@ -140,11 +140,12 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
         heat[i] += conductance * (p.temp[j] - p.temp[i]);
     };
     let mut pairs = 0;
+    let history = list.histories_by_entry();
     for i in 0..n {
         for e in list.range(i) {
             let j = list.neighbors[e] as usize;
-            from_side(i, j, list.history[e]);
-            from_side(j, i, list.history[e].reversed());
+            from_side(i, j, history[e]);
+            from_side(j, i, history[e].reversed());
             pairs += list.touching[e] as usize;
         }
     }
@@ -215,7 +216,7 @@ fn the_pair_stage_gives_the_same_bits_whatever_its_chunks() {
         let bits = |v: &[[f64; 3]]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
         let springs = after
             .neighbors
-            .history
+            .histories_by_entry()
             .iter()
             .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
             .collect::<Vec<_>>();
@@ -257,13 +258,12 @@ fn a_rebuild_keeps_every_open_contact_history() {
     let open = |sim: &Simulation| {
         let (p, list) = (&sim.particles, &sim.neighbors);
         let mut map: BTreeMap<(u32, u32), ContactHistory> = BTreeMap::new();
+        list.for_each_touching(|i, e, &h| {
+            let (a, b) = (p.id[i], p.id[list.neighbors[e] as usize]);
+            let key = (a.min(b), a.max(b));
+            map.insert(key, if a < b { h } else { h.reversed() });
+        });
         for i in 0..p.len() {
-            for e in list.range(i).filter(|&e| list.touching[e]) {
-                let (a, b) = (p.id[i], p.id[list.neighbors[e] as usize]);
-                let h = list.history[e];
-                let key = (a.min(b), a.max(b));
-                map.insert(key, if a < b { h } else { h.reversed() });
-            }
             for e in list.wall_range(i).filter(|&e| list.wall_touching[e]) {
                 let w = p.len() as u32 + list.wall_index[e] as u32;
                 map.insert((p.id[i], w), list.wall_history[e]);

@@ -13,6 +13,7 @@ use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::slices::for_each_task;
 use crate::wall::WallSet;
+use std::cell::RefCell;
 use std::ops::Range;
 
 /// Particles per parallel task in the wall stage.
@@ -20,6 +21,12 @@ const BLOCK: usize = 1024;
 /// Particles per chunk of the pair stage's layers: a chunk's state and lists stay in the
 /// cache between its two phases.
 const CHUNK: u32 = 16384;
+
+thread_local! {
+    /// A pair task's histories from the last step, read from this copy while the new ones
+    /// are written over them (packed, a task may have more contacts than before).
+    static OLD_HISTORIES: RefCell<Vec<ContactHistory>> = const { RefCell::new(Vec::new()) };
+}
 
 /// Everything constant during a step.
 #[derive(Debug, Clone, PartialEq)]
@@ -145,6 +152,7 @@ pub fn pair_interactions_in_chunks(
         force.fill([0.0; 3]);
         torque.fill([0.0; 3]);
         heat_flow.fill(0.0);
+        return 0;
     }
     let spheres = SphereArrays {
         pos,
@@ -160,55 +168,72 @@ pub fn pair_interactions_in_chunks(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
-    // task k of a phase owns layer l = phase + 2k: it writes the slots of l and l + 1 and
-    // the entries of l (its pieces reach the next task's start; it touches only those)
+    // the task of layer l writes the slots of l and l + 1 and the entries of l, from the
+    // start of its pieces (which reach the next task's start; it touches only those)
+    let start = |l: usize| {
+        let s = layer_start[l] as usize;
+        let e = offsets[s] as usize;
+        ((s, s), (s, (e, e)))
+    };
+    let layer_task = |l: usize, ((f, t), (q, (h, touch))): Accumulators| {
+        let first_slot = layer_start[l] as usize;
+        let first_entry = offsets[first_slot] as usize;
+        if l.is_multiple_of(2) {
+            // an even task is the first to write its two layers: their sums start from
+            // zero here, where the task is about to use them, not in a pass of their own
+            // over memory
+            let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
+            f[..written].fill([0.0; 3]);
+            t[..written].fill([0.0; 3]);
+            q[..written].fill(0.0);
+        }
+        let slots = first_slot..layer_start[l + 1] as usize;
+        let layer_entries = offsets[slots.end] as usize - first_entry;
+        // the layer's histories are packed: those of its touching entries, in entry
+        // order, from its first entry on (the stream the stage reads is the contacts',
+        // not the list's)
+        let touched = touch[..layer_entries]
+            .iter()
+            .map(|&t| usize::from(t))
+            .sum::<usize>();
+        OLD_HISTORIES.with_borrow_mut(|old| {
+            old.clear();
+            old.extend_from_slice(&h[..touched]);
+            old.push(ContactHistory::default());
+            let mut batch = PairBatch::default();
+            // the owner's sums are kept apart and added once its contacts are done, as
+            // each pair's partner sums are added in pair order: the order of every sum
+            // is fixed by the list alone
+            let mut owner = Owner::default();
+            let entries = ListEntries {
+                slots,
+                offsets,
+                partners,
+                first_entry,
+                fresh: touched as u32,
+            };
+            let mut evaluate = |batch: &mut PairBatch| {
+                batch.evaluate(&constants, &spheres, old, h);
+                owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
+            };
+            let touching_pairs =
+                narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
+            // the batch holds fewer than a full batch's contacts now: one evaluation
+            evaluate(&mut batch);
+            owner.add_to((f, t, q), first_slot);
+            touching_pairs
+        })
+    };
+    // task k of a phase owns layer l = phase + 2k (its pieces reach the next task's start)
     let mut run = |phase: usize, tasks: Range<usize>| {
-        let layer = |k: usize| phase + 2 * k;
-        let start = |k: usize| {
-            let s = layer_start[layer(k)] as usize;
-            let e = offsets[s] as usize;
-            ((s, s), (s, (e, e)))
-        };
         let arrays = (
             (&mut force[..], &mut torque[..]),
             (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
         );
-        let work = |k: usize, ((f, t), (q, (h, touch))): Accumulators| {
-            let l = layer(k);
-            let first_slot = layer_start[l] as usize;
-            let first_entry = offsets[first_slot] as usize;
-            if phase == 0 {
-                // an even task is the first to write its two layers: their sums start
-                // from zero here, where the task is about to use them, not in a pass of
-                // their own over memory
-                let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
-                f[..written].fill([0.0; 3]);
-                t[..written].fill([0.0; 3]);
-                q[..written].fill(0.0);
-            }
-            let mut batch = PairBatch::default();
-            // the owner's sums are kept apart and added once its contacts are done, as
-            // each pair's partner sums are added in pair order: the order of every sum is
-            // fixed by the list alone
-            let mut owner = Owner::default();
-            let entries = ListEntries {
-                slots: first_slot..layer_start[l + 1] as usize,
-                offsets,
-                partners,
-                first_entry,
-            };
-            let mut evaluate = |batch: &mut PairBatch, h: &mut [ContactHistory]| {
-                batch.evaluate(&constants, &spheres, h);
-                owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
-            };
-            let touching_pairs =
-                narrow_phase::scan(&entries, pos, radius, touch, h, &mut batch, &mut evaluate);
-            // the batch holds fewer than a full batch's contacts now: one evaluation
-            evaluate(&mut batch, h);
-            owner.add_to((f, t, q), first_slot);
-            touching_pairs
-        };
-        for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
+        let origin = ((0, 0), (0, (0, 0)));
+        let layer = |k: usize| phase + 2 * k;
+        let work = |k: usize, pieces: Accumulators| layer_task(layer(k), pieces);
+        for_each_task(arrays, origin, tasks, &|k| start(layer(k)), &work)
     };
     // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
     // layer of each, and each particle's sums keep that order). Rather than all even

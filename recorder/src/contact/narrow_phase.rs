@@ -1,5 +1,7 @@
 //! The pair stage's narrow phase: which entries of the half list touch now. Touching pairs
-//! go into a [`PairBatch`]; an entry that stopped touching gets its history cleared.
+//! go into a [`PairBatch`] with the index of their history before this step: the histories
+//! of a task's touching entries are stored packed, in entry order, so the `k`-th entry that
+//! touched at the last step has history `k`, and a pair that has just touched gets a zero one.
 //!
 //! About one entry in three touches, in no pattern the branch predictor can learn, so the
 //! scan is worth doing without a branch per entry: on CPUs with AVX-512 eight entries are
@@ -8,7 +10,6 @@
 
 use super::contact_sphere_sphere::overlapping;
 use super::pair_batch::PairBatch;
-use super::ContactHistory;
 use crate::math::*;
 use std::ops::Range;
 
@@ -19,24 +20,24 @@ pub struct ListEntries<'a> {
     /// Entries of slot `i` are `offsets[i]..offsets[i + 1]` of `partners`.
     pub offsets: &'a [u32],
     pub partners: &'a [u32],
-    /// Entry `e`'s history and touching flag are at `e - first_entry` of the slices the scan
-    /// is given.
+    /// Entry `e`'s touching flag is at `e - first_entry` of the slice the scan is given.
     pub first_entry: usize,
+    /// The old-history index of a pair that has just touched: a zero history.
+    pub fresh: u32,
 }
 
-/// Scans the entries: each touching pair is pushed into `batch`, and `full(batch, history)`
-/// is called whenever the batch is full (the caller evaluates it and consumes what it
-/// evaluated). Entries that stopped touching get a zero history. Returns the touching
-/// pairs; the batch may hold some of them when it returns.
+/// Scans the entries and updates their touching flags: each touching pair is pushed into
+/// `batch`, and `full(batch)` is called whenever the batch is full (the caller evaluates it
+/// and consumes what it evaluated). Returns the touching pairs; the batch may hold some of
+/// them when it returns.
 #[inline(always)]
 pub fn scan(
     entries: &ListEntries,
     pos: &[Vec3],
     radius: &[f64],
     touching: &mut [bool],
-    history: &mut [ContactHistory],
     batch: &mut PairBatch,
-    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+    full: &mut impl FnMut(&mut PairBatch),
 ) -> u64 {
     #[cfg(target_arch = "x86_64")]
     {
@@ -45,10 +46,10 @@ pub fn scan(
             && std::arch::is_x86_feature_detected!("avx512bw")
         {
             // SAFETY: the CPU has the three features, checked just above
-            return unsafe { scan_avx512(entries, pos, radius, touching, history, batch, full) };
+            return unsafe { scan_avx512(entries, pos, radius, touching, batch, full) };
         }
     }
-    scan_entries(entries, pos, radius, touching, history, batch, full)
+    scan_entries(entries, pos, radius, touching, batch, full)
 }
 
 /// One entry at a time.
@@ -58,34 +59,33 @@ fn scan_entries(
     pos: &[Vec3],
     radius: &[f64],
     touch: &mut [bool],
-    history: &mut [ContactHistory],
     batch: &mut PairBatch,
-    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+    full: &mut impl FnMut(&mut PairBatch),
 ) -> u64 {
     let ListEntries {
         slots,
         offsets,
         partners,
         first_entry,
-    } = entries;
-    let mut touching = 0;
+        fresh,
+    } = entries.clone();
+    let (mut touching, mut touched_before) = (0, 0);
     for i in slots.clone() {
         let (pos_i, radius_i) = (pos[i], radius[i]);
         for e in offsets[i] as usize..offsets[i + 1] as usize {
             let j = partners[e] as usize;
             let delta = sub(pos_i, pos[j]);
             let local = e - first_entry;
+            let old = if touch[local] { touched_before } else { fresh };
+            touched_before += u32::from(touch[local]);
             let Some(r2) = overlapping(delta, radius_i, radius[j]) else {
-                if touch[local] {
-                    history[local] = ContactHistory::default();
-                    touch[local] = false;
-                }
+                touch[local] = false;
                 continue;
             };
             touch[local] = true;
             touching += 1;
-            if batch.push(i, j, local, delta, r2) {
-                full(batch, history);
+            if batch.push(i, j, old as usize, delta, r2) {
+                full(batch);
             }
         }
     }
@@ -93,7 +93,8 @@ fn scan_entries(
 }
 
 /// Eight entries at a time: the partners' positions and radii are gathered, the overlap
-/// test gives a mask, and the hits are compressed into the batch. The arithmetic is
+/// test gives a mask, and the hits are compressed into the batch (with their old history
+/// indices, expanded from a running count into the lanes that touched before). The arithmetic is
 /// `overlapping`'s, operation for operation (no fused multiply-add), so the pairs and their
 /// `delta` and `r2` are those of [`scan_entries`].
 #[cfg(target_arch = "x86_64")]
@@ -103,9 +104,8 @@ fn scan_avx512(
     pos: &[Vec3],
     radius: &[f64],
     touch: &mut [bool],
-    history: &mut [ContactHistory],
     batch: &mut PairBatch,
-    full: &mut impl FnMut(&mut PairBatch, &mut [ContactHistory]),
+    full: &mut impl FnMut(&mut PairBatch),
 ) -> u64 {
     use std::arch::x86_64::*;
     let ListEntries {
@@ -113,7 +113,8 @@ fn scan_avx512(
         offsets,
         partners,
         first_entry,
-    } = entries;
+        fresh,
+    } = entries.clone();
     let coordinates = pos.as_ptr() as *const f64;
     let last = offsets[slots.end] as usize;
     // the masked loads and stores below rely on it (offsets do not decrease)
@@ -121,7 +122,8 @@ fn scan_avx512(
     assert!(pos.len() == radius.len() && pos.len() <= i32::MAX as usize / 3);
     let slot_count = _mm256_set1_epi32(pos.len() as i32);
     let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let mut touching = 0;
+    let fresh = _mm256_set1_epi32(fresh as i32);
+    let (mut touching, mut touched_before) = (0, 0u32);
     for i in slots.clone() {
         let (pos_i, radius_i) = (pos[i], radius[i]);
         let xi = pos_i.map(|x| _mm512_set1_pd(x));
@@ -170,17 +172,15 @@ fn scan_avx512(
                 );
                 (j, delta, r2, hit, was)
             };
-            // contacts that just ended: rare, one branch per group of eight
-            let mut ended = was & !hit;
-            while ended != 0 {
-                history[local + ended.trailing_zeros() as usize] = ContactHistory::default();
-                ended &= ended - 1;
-            }
+            // the lanes that touched before take the next old indices in order, the others
+            // the zero history
+            let count = _mm256_add_epi32(_mm256_set1_epi32(touched_before as i32), lane);
+            let old = _mm256_mask_expand_epi32(fresh, was, count);
+            touched_before += was.count_ones();
             if hit != 0 {
                 touching += u64::from(hit.count_ones());
-                let entry = _mm256_add_epi32(_mm256_set1_epi32(local as i32), lane);
-                if batch.push_lanes(hit, i, j, entry, delta, r2) {
-                    full(batch, history);
+                if batch.push_lanes(hit, i, j, old, delta, r2) {
+                    full(batch);
                 }
             }
             e += 8;
@@ -199,19 +199,18 @@ mod tests {
 
     type Pushed = Vec<(u32, u32, u32, [u64; 3], u64)>;
 
-    /// What a scan did: the pairs pushed in order (bits of `delta` and `r2`), the touching
-    /// flags and histories after it, and the count it returned.
+    /// What a scan did: the pairs pushed in order (old history index, bits of `delta` and
+    /// `r2`), the touching flags after it, and the count it returned.
     fn outcome(
         vector: bool,
         entries: &ListEntries,
         pos: &[Vec3],
         radius: &[f64],
         touching: &[bool],
-        history: &[ContactHistory],
-    ) -> (Pushed, Vec<bool>, Vec<ContactHistory>, u64) {
-        let (mut touch, mut hist) = (touching.to_vec(), history.to_vec());
+    ) -> (Pushed, Vec<bool>, u64) {
+        let mut touch = touching.to_vec();
         let mut pushed = Pushed::new();
-        let mut take = |batch: &mut PairBatch, _: &mut [ContactHistory]| {
+        let mut take = |batch: &mut PairBatch| {
             // what `evaluate` would take: the first LANES pushed
             let n = batch.len().min(LANES);
             for l in 0..n {
@@ -228,19 +227,45 @@ mod tests {
                     && std::arch::is_x86_feature_detected!("avx512bw")
             );
             // SAFETY: the features were checked just above
-            unsafe {
-                scan_avx512(
-                    entries, pos, radius, &mut touch, &mut hist, &mut batch, &mut take,
-                )
-            }
+            unsafe { scan_avx512(entries, pos, radius, &mut touch, &mut batch, &mut take) }
         } else {
-            scan_entries(
-                entries, pos, radius, &mut touch, &mut hist, &mut batch, &mut take,
-            )
+            scan_entries(entries, pos, radius, &mut touch, &mut batch, &mut take)
         };
-        take(&mut batch, &mut []);
+        take(&mut batch);
         assert_eq!(batch.len(), 0);
-        (pushed, touch, hist, count)
+        (pushed, touch, count)
+    }
+
+    #[test]
+    fn a_pair_gets_the_packed_index_of_its_old_history_or_the_zero_one() {
+        // four partners of sphere 0: 1 and 2 touch it now, 3 is out of reach, 4 touches
+        let pos = [
+            [0.0; 3],
+            [0.009, 0.0, 0.0],
+            [0.0, 0.0095, 0.0],
+            [0.02, 0.0, 0.0],
+            [0.0, 0.0, -0.0099],
+        ];
+        let radius = [0.005; 5];
+        let (offsets, partners) = ([0, 4, 4, 4, 4, 4], [1, 2, 3, 4]);
+        let entries = ListEntries {
+            slots: 0..5,
+            offsets: &offsets,
+            partners: &partners,
+            first_entry: 0,
+            fresh: 99,
+        };
+        // entries 0, 2 and 3 touched at the last step: old histories 0, 1 and 2
+        let (pushed, touch, count) =
+            outcome(false, &entries, &pos, &radius, &[true, false, true, true]);
+        let old: Vec<u32> = pushed.iter().map(|p| p.2).collect();
+        assert_eq!(
+            old,
+            [0, 99, 2],
+            "entry 1 has just touched, entry 2 no longer does"
+        );
+        assert_eq!(touch, [true, true, false, true]);
+        assert_eq!(count, 3);
     }
 
     #[test]
@@ -275,34 +300,25 @@ mod tests {
             offsets: &offsets,
             partners: &partners,
             first_entry,
+            fresh: u32::MAX,
         };
         let local = partners.len() - first_entry;
         let touching: Vec<bool> = (0..local).map(|_| u() < 0.4).collect();
-        let history: Vec<ContactHistory> = touching
-            .iter()
-            .map(|&t| {
-                let s = if t { 1e-4 * (1.0 + u()) } else { 0.0 };
-                ContactHistory {
-                    shear: [s, -s, 0.5 * s],
-                    roll: [0.1 * s; 3],
-                }
-            })
-            .collect();
 
-        let one = outcome(false, &entries, &pos, &radius, &touching, &history);
-        let eight = outcome(true, &entries, &pos, &radius, &touching, &history);
+        let one = outcome(false, &entries, &pos, &radius, &touching);
+        let eight = outcome(true, &entries, &pos, &radius, &touching);
         assert_eq!(one.0, eight.0, "pushed pairs");
         assert_eq!(one.1, eight.1, "touching flags");
-        assert_eq!(one.2, eight.2, "histories");
-        assert_eq!(one.3, eight.3, "count");
+        assert_eq!(one.2, eight.2, "count");
         // the sample exercises every path: hits, misses, contacts that ended and several
         // full batches
         let ended = (0..local).filter(|&e| touching[e] && !one.1[e]).count();
         let hits = one.1.iter().filter(|&&t| t).count();
+        let kept = one.0.iter().filter(|p| p.2 != u32::MAX).count();
         assert!(
-            ended > 0 && hits > 3 * 16 && hits < local,
-            "{ended} ended, {hits} of {local}"
+            ended > 0 && kept > 0 && kept < hits && hits > 3 * 16 && hits < local,
+            "{ended} ended, {kept} kept, {hits} of {local}"
         );
-        assert_eq!(one.3 as usize, hits);
+        assert_eq!(one.2 as usize, hits);
     }
 }

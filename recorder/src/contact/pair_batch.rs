@@ -46,10 +46,14 @@ pub struct PairBatch {
     len: usize,
     /// Contacts evaluated by the last `evaluate` (the first ones pushed).
     ready: usize,
+    /// Contacts evaluated since the batch was made: the next evaluated contact's history
+    /// goes to this index of the new histories.
+    evaluated: usize,
     owner: [u32; CAPACITY],
     partner: [u32; CAPACITY],
-    /// Index of the pair's history in the history slice handed to `evaluate`.
-    entry: [u32; CAPACITY],
+    /// Index of the pair's history before this step in the old histories handed to
+    /// `evaluate` (a pair that has just touched points at a zero history).
+    old: [u32; CAPACITY],
     delta: [[f64; CAPACITY]; 3],
     r2: [f64; CAPACITY],
     lanes: Lanes,
@@ -80,9 +84,10 @@ impl Default for PairBatch {
         Self {
             len: 0,
             ready: 0,
+            evaluated: 0,
             owner: [0; CAPACITY],
             partner: [0; CAPACITY],
-            entry: [0; CAPACITY],
+            old: [0; CAPACITY],
             delta: [[0.0; CAPACITY]; 3],
             r2: [0.0; CAPACITY],
             lanes: Lanes {
@@ -118,20 +123,13 @@ pub struct PairConstants<'a> {
 
 impl PairBatch {
     /// Adds the touching pair `(owner, partner)` whose centres are `delta` apart (`r2` its
-    /// squared length) and whose history is `entry`; true when the batch is full.
+    /// squared length) and whose history was `old`; true when the batch is full.
     #[inline(always)]
-    pub fn push(
-        &mut self,
-        owner: usize,
-        partner: usize,
-        entry: usize,
-        delta: Vec3,
-        r2: f64,
-    ) -> bool {
+    pub fn push(&mut self, owner: usize, partner: usize, old: usize, delta: Vec3, r2: f64) -> bool {
         let l = self.len;
         self.owner[l] = owner as u32;
         self.partner[l] = partner as u32;
-        self.entry[l] = entry as u32;
+        self.old[l] = old as u32;
         for (d, &x) in self.delta.iter_mut().zip(&delta) {
             d[l] = x;
         }
@@ -140,8 +138,8 @@ impl PairBatch {
         self.len >= LANES
     }
 
-    /// Adds the lanes of `hit` among 8 entries of `owner` (partner slots, history indices,
-    /// centre distances `delta` and their squared lengths `r2`), keeping their order; true
+    /// Adds the lanes of `hit` among 8 entries of `owner` (partner slots, old history
+    /// indices, centre distances `delta` and their squared lengths `r2`), keeping their order; true
     /// when the batch is full. The batch must not be full before.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
@@ -152,7 +150,7 @@ impl PairBatch {
         hit: std::arch::x86_64::__mmask8,
         owner: usize,
         partner: std::arch::x86_64::__m256i,
-        entry: std::arch::x86_64::__m256i,
+        old: std::arch::x86_64::__m256i,
         delta: [std::arch::x86_64::__m512d; 3],
         r2: std::arch::x86_64::__m512d,
     ) -> bool {
@@ -169,10 +167,7 @@ impl PairBatch {
                 stored(&mut self.partner),
                 _mm256_maskz_compress_epi32(hit, partner),
             );
-            _mm256_storeu_si256(
-                stored(&mut self.entry),
-                _mm256_maskz_compress_epi32(hit, entry),
-            );
+            _mm256_storeu_si256(stored(&mut self.old), _mm256_maskz_compress_epi32(hit, old));
             for (a, d) in self.delta.iter_mut().zip(delta) {
                 _mm512_storeu_pd(a.as_mut_ptr().add(l), _mm512_maskz_compress_pd(hit, d));
             }
@@ -185,25 +180,28 @@ impl PairBatch {
         self.len >= LANES
     }
 
-    /// Evaluates the first [`LANES`] contacts pushed (all if fewer) and advances their
-    /// histories in `history`; their responses are then read with [`PairBatch::response`]
-    /// in the order they were pushed, and [`PairBatch::consume`] removes them.
+    /// Evaluates the first [`LANES`] contacts pushed (all if fewer): their histories are
+    /// read from `old` and the advanced ones written to `new`, in the order the contacts
+    /// were pushed (the batch's `k`-th evaluated contact to `new[k]`). Their responses are
+    /// then read with [`PairBatch::response`], and [`PairBatch::consume`] removes them.
     pub fn evaluate(
         &mut self,
         constants: &PairConstants,
         spheres: &SphereArrays,
-        history: &mut [ContactHistory],
+        old: &[ContactHistory],
+        new: &mut [ContactHistory],
     ) {
         let n = self.len.min(LANES);
         self.ready = n;
         if n == 0 {
             return;
         }
-        self.gather(n, constants, spheres, history);
+        self.gather(n, constants, spheres, old);
         run_lanes(&mut self.lanes, &self.delta, &self.r2, n, constants);
         let lanes = &self.lanes;
-        for l in 0..n {
-            history[self.entry[l] as usize] = ContactHistory {
+        let new = &mut new[self.evaluated..self.evaluated + n];
+        for (l, history) in new.iter_mut().enumerate() {
+            *history = ContactHistory {
                 shear: lane3(&lanes.shear, l),
                 roll: lane3(&lanes.roll, l),
             };
@@ -240,7 +238,7 @@ impl PairBatch {
         (self.owner[l] as usize, self.partner[l] as usize, response)
     }
 
-    /// Owner, partner, history index, `delta` and `r2` of the `l`-th contact pushed.
+    /// Owner, partner, old history index, `delta` and `r2` of the `l`-th contact pushed.
     #[cfg(test)]
     pub(crate) fn pushed(&self, l: usize) -> (u32, u32, u32, Vec3, f64) {
         assert!(l < self.len);
@@ -248,7 +246,7 @@ impl PairBatch {
         (
             self.owner[l],
             self.partner[l],
-            self.entry[l],
+            self.old[l],
             delta,
             self.r2[l],
         )
@@ -259,7 +257,7 @@ impl PairBatch {
         self.skip(self.ready);
     }
 
-    /// Removes the first `ready` contacts pushed.
+    /// Removes the first `ready` contacts pushed (they count as evaluated).
     pub(crate) fn skip(&mut self, ready: usize) {
         let len = self.len;
         assert!(ready <= len);
@@ -267,7 +265,7 @@ impl PairBatch {
             let rest = ready..len;
             self.owner.copy_within(rest.clone(), 0);
             self.partner.copy_within(rest.clone(), 0);
-            self.entry.copy_within(rest.clone(), 0);
+            self.old.copy_within(rest.clone(), 0);
             for d in &mut self.delta {
                 d.copy_within(rest.clone(), 0);
             }
@@ -275,20 +273,21 @@ impl PairBatch {
         }
         self.len = len - ready;
         self.ready = 0;
+        self.evaluated += ready;
     }
 
-    /// Copies the first `n` lanes' sphere states and histories into the lane arrays.
+    /// Copies the first `n` lanes' sphere states and old histories into the lane arrays.
     fn gather(
         &mut self,
         n: usize,
         constants: &PairConstants,
         spheres: &SphereArrays,
-        history: &[ContactHistory],
+        old: &[ContactHistory],
     ) {
         let lanes = &mut self.lanes;
         for l in 0..n {
             let (i, j) = (self.owner[l] as usize, self.partner[l] as usize);
-            let h = &history[self.entry[l] as usize];
+            let h = &old[self.old[l] as usize];
             for a in 0..3 {
                 lanes.vel_i[a][l] = spheres.vel[i][a];
                 lanes.vel_j[a][l] = spheres.vel[j][a];
@@ -535,11 +534,11 @@ mod tests {
                     temp,
                 } = spheres;
                 let start = &sample.history;
-                let mut batched = start.clone();
+                let mut batched = vec![ContactHistory::default(); start.len()];
                 let mut responses = vec![];
                 let mut batch = PairBatch::default();
                 let mut evaluate = |batch: &mut PairBatch| {
-                    batch.evaluate(&constants, &spheres, &mut batched);
+                    batch.evaluate(&constants, &spheres, start, &mut batched);
                     responses.extend((0..batch.ready()).map(|l| batch.response(l)));
                     batch.consume();
                 };

@@ -1,5 +1,5 @@
 //! The half Verlet list in CSR form (each pair once, partner after the particle in slot
-//! order) and the wall candidates, with every contact's history stored next to its entry.
+//! order) and the wall candidates, with the open contacts' histories beside them.
 //! On rebuild the particles are re-sorted in cell order (memory order is worth several times
 //! in the force loop) and every open contact's history follows its pair into the new list.
 //! The lists are counted, then filled in place: a rebuild allocates nothing once the arrays
@@ -23,9 +23,12 @@ pub struct NeighborList {
     pub offsets: Vec<u32>,
     /// Partner slots, each greater than the owner's slot and in its layer or the next.
     pub neighbors: Vec<u32>,
-    /// History of each entry's contact, seen from the owner (zero while open).
+    /// Histories of the touching entries, seen from the owner, packed layer by layer: layer
+    /// `l`'s in entry order from its first entry `offsets[layer_start[l]]` on (the rest of
+    /// its range is unused). About one entry in four touches, so the pair stage streams a
+    /// quarter of what one history per entry would cost it.
     pub history: Vec<ContactHistory>,
-    /// Whether each entry touched at the last step (its history is non-zero only then).
+    /// Whether each entry touched at the last step.
     pub touching: Vec<bool>,
     /// First slot of each layer of the cell grid, and the particle count at the end.
     pub layer_start: Vec<u32>,
@@ -62,6 +65,8 @@ pub struct NeighborList {
 struct Carried {
     /// Contacts of id `a` are `start[a]..start[a + 1]`.
     start: Vec<u32>,
+    /// Where the next contact of each id goes while they are collected.
+    next: Vec<u32>,
     /// Partner id (walls: particle count + wall index) and history seen from the owner.
     contacts: Vec<(u32, ContactHistory)>,
 }
@@ -90,18 +95,46 @@ impl NeighborList {
         }
     }
 
+    /// Calls `found(slot, entry, history)` for every touching entry, in entry order.
+    pub fn for_each_touching(&self, mut found: impl FnMut(usize, usize, &ContactHistory)) {
+        for layer in self.layer_start.windows(2) {
+            let slots = layer[0] as usize..layer[1] as usize;
+            let mut packed = self.offsets[slots.start] as usize;
+            for i in slots {
+                for e in self.range(i).filter(|&e| self.touching[e]) {
+                    found(i, e, &self.history[packed]);
+                    packed += 1;
+                }
+            }
+        }
+    }
+
+    /// The history of every entry (zero for those not touching).
+    pub fn histories_by_entry(&self) -> Vec<ContactHistory> {
+        let mut by_entry = vec![ContactHistory::default(); self.neighbors.len()];
+        self.for_each_touching(|_, e, h| by_entry[e] = *h);
+        by_entry
+    }
+
     /// Collects the open contacts (pairs and walls) by owner id into `self.carried`.
     fn carry_open_contacts(&mut self, ids: &[u32]) {
         let n = ids.len();
         let slots = self.offsets.len().saturating_sub(1);
-        let Carried { start, contacts } = &mut self.carried;
+        // taken out while the list is read, put back at the end
+        let mut carried = std::mem::take(&mut self.carried);
+        let Carried {
+            start,
+            next,
+            contacts,
+        } = &mut carried;
         start.clear();
         start.resize(n + 1, 0);
         for i in 0..slots {
-            let pairs = self.offsets[i] as usize..self.offsets[i + 1] as usize;
-            let walls = self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize;
-            let pairs = self.touching[pairs].iter().filter(|&&t| t).count();
-            let walls = self.wall_touching[walls].iter().filter(|&&t| t).count();
+            let pairs = self.touching[self.range(i)].iter().filter(|&&t| t).count();
+            let walls = self.wall_touching[self.wall_range(i)]
+                .iter()
+                .filter(|&&t| t)
+                .count();
             start[ids[i] as usize + 1] += (pairs + walls) as u32;
         }
         for a in 0..n {
@@ -109,21 +142,23 @@ impl NeighborList {
         }
         contacts.clear();
         contacts.resize(start[n] as usize, (0, ContactHistory::default()));
+        // each owner's pairs first, then its walls
+        next.clear();
+        next.extend_from_slice(start);
+        self.for_each_touching(|i, e, &h| {
+            let at = &mut next[ids[i] as usize];
+            contacts[*at as usize] = (ids[self.neighbors[e] as usize], h);
+            *at += 1;
+        });
         for i in 0..slots {
-            let mut at = start[ids[i] as usize] as usize;
-            for e in self.offsets[i] as usize..self.offsets[i + 1] as usize {
-                if self.touching[e] {
-                    contacts[at] = (ids[self.neighbors[e] as usize], self.history[e]);
-                    at += 1;
-                }
-            }
-            for e in self.wall_offsets[i] as usize..self.wall_offsets[i + 1] as usize {
-                if self.wall_touching[e] {
-                    contacts[at] = (n as u32 + self.wall_index[e] as u32, self.wall_history[e]);
-                    at += 1;
-                }
+            for e in self.wall_range(i).filter(|&e| self.wall_touching[e]) {
+                let at = &mut next[ids[i] as usize];
+                let wall = n as u32 + self.wall_index[e] as u32;
+                contacts[*at as usize] = (wall, self.wall_history[e]);
+                *at += 1;
             }
         }
+        self.carried = carried;
     }
 
     /// Re-sorts `particles` into cell order and rebuilds the lists, carrying histories over.
@@ -195,13 +230,13 @@ impl NeighborList {
             .resize(wall_entries, ContactHistory::default());
         self.wall_touching.resize(wall_entries, false);
 
-        // task b fills the entries and wall candidates of the slots of block b
-        let (offsets, wall_offsets) = (&self.offsets, &self.wall_offsets);
-        let start = |b: usize| {
-            let (e, w) = (
-                offsets[b * BLOCK] as usize,
-                wall_offsets[b * BLOCK] as usize,
-            );
+        // task l fills the entries and wall candidates of the slots of layer l (whose
+        // histories are packed from the layer's first entry on)
+        let (offsets, wall_offsets, layer_start) =
+            (&self.offsets, &self.wall_offsets, &self.layer_start);
+        let start = |l: usize| {
+            let first = layer_start[l] as usize;
+            let (e, w) = (offsets[first] as usize, wall_offsets[first] as usize);
             (e, (e, (e, (w, (w, w)))))
         };
         let (ids, carried) = (&particles.id, &self.carried);
@@ -218,16 +253,19 @@ impl NeighborList {
                 ),
             ),
         );
-        let fill = |b: usize, (partner, (history, (touch, (wall, (wall_history, wall_touch))))): ListPieces| {
-            let (mut e, mut w) = (0, 0);
-            for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
+        let fill = |l: usize, (partner, (history, (touch, (wall, (wall_history, wall_touch))))): ListPieces| {
+            let (mut e, mut w, mut packed) = (0, 0, 0);
+            for i in layer_start[l] as usize..layer_start[l + 1] as usize {
                 search.partners(i, |j, now_touching| {
                     // a history matters only to a pair touching now (the pair stage's
                     // own test): it resets the others
                     let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
                     partner[e] = j as u32;
-                    history[e] = h.unwrap_or_default();
                     touch[e] = h.is_some();
+                    if let Some(h) = h {
+                        history[packed] = h;
+                        packed += 1;
+                    }
                     e += 1;
                 });
                 search.walls(i, |k| {
@@ -241,7 +279,7 @@ impl NeighborList {
             0
         };
         let origin = (0, (0, (0, (0, (0, 0)))));
-        for_each_task(arrays, origin, 0..n.div_ceil(BLOCK), &start, &fill);
+        for_each_task(arrays, origin, 0..grid.layers(), &start, &fill);
 
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
