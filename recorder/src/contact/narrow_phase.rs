@@ -94,9 +94,9 @@ fn scan_entries(
 
 /// Eight entries at a time: the partners' positions and radii are gathered, the overlap
 /// test gives a mask, and the hits are compressed into the batch (with their old history
-/// indices, expanded from a running count into the lanes that touched before). The arithmetic is
-/// `overlapping`'s, operation for operation (no fused multiply-add), so the pairs and their
-/// `delta` and `r2` are those of [`scan_entries`].
+/// indices, expanded from a running count into the lanes that touched before). The
+/// arithmetic is `overlapping`'s, operation for operation (no fused multiply-add), so the
+/// pairs and their `delta` and `r2` are those of [`scan_entries`].
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw")]
 fn scan_avx512(

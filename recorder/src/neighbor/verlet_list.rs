@@ -25,8 +25,8 @@ pub struct NeighborList {
     pub neighbors: Vec<u32>,
     /// Histories of the touching entries, seen from the owner, packed layer by layer: layer
     /// `l`'s in entry order from its first entry `offsets[layer_start[l]]` on (the rest of
-    /// its range is unused). About one entry in three touches, so the pair stage streams a
-    /// third of what one history per entry would cost it.
+    /// its range is unused). Most entries lie within the skin without touching, so the pair
+    /// stage streams the contacts' histories, not one per entry.
     pub history: Vec<ContactHistory>,
     /// Whether each entry touched at the last step.
     pub touching: Vec<bool>,
