@@ -14,7 +14,7 @@ use crate::slices::for_each_task;
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
-/// Particles per parallel task in the list build.
+/// Particles per parallel task when the list entries are counted (the fill goes by layer).
 const BLOCK: usize = 512;
 
 #[derive(Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
