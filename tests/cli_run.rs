@@ -65,7 +65,7 @@ fn run_json_reports_the_documented_keys() {
     assert_eq!(v["particles"], 250);
     assert_eq!(v["steps_heating"], 2000);
     assert_eq!(v["hot_mean_start"], 30.0);
-    for stage in ["neighbor", "pair", "wall", "integrate"] {
+    for stage in ["neighbor", "contact", "integrate"] {
         assert!(v["stage_seconds"][stage].as_f64().unwrap() >= 0.0);
     }
     let (start, end) = (

@@ -109,7 +109,7 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
     use recorder::contact::contact_sphere_sphere::{self as ss, SphereState};
     use recorder::contact::{contact_sphere_wall as sw, hertz_mindlin};
     use recorder::math::*;
-    use recorder::pipeline::{pair_interactions, wall_interactions};
+    use recorder::pipeline::contact_interactions;
 
     let before = turning_small_drum(2000, true);
     let (p, list, params) = (&before.particles, &before.neighbors, &before.params);
@@ -149,10 +149,12 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
             pairs += list.touching[e] as usize;
         }
     }
+    let mut wall_contacts = 0;
     for i in 0..n {
         for e in list.wall_range(i) {
             let w = list.wall_index[e] as usize;
             if let Some(c) = before.walls.contact(w, p.pos[i], p.radius[i]) {
+                wall_contacts += 1;
                 let (kin, lever) = sw::kinematics(&state(i), &c);
                 let mut h = list.wall_history[e];
                 let resp = hertz_mindlin::respond(&params.particle_wall, &kin, &mut h, params.dt);
@@ -166,14 +168,16 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
         "the bed should be in contact: {pairs} touching pairs"
     );
 
+    assert!(wall_contacts > 0, "the bed should touch the drum");
     let mut after = before.clone();
-    pair_interactions(&after.params, &mut after.particles, &mut after.neighbors);
-    wall_interactions(
+    let count = contact_interactions(
         &after.params,
         &mut after.particles,
         &mut after.neighbors,
         &after.walls,
     );
+    assert_eq!(count.pair_entries, 2 * pairs as u64);
+    assert_eq!(count.wall, wall_contacts);
     let scale_f = force.iter().map(|f| norm2(*f).sqrt()).fold(0.0, f64::max);
     let scale_t = torque.iter().map(|t| norm2(*t).sqrt()).fold(0.0, f64::max);
     let scale_q = heat.iter().map(|q| q.abs()).fold(0.0, f64::max);
@@ -195,22 +199,26 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
     }
 }
 
-/// The pair stage takes the layers chunk by chunk (even tasks, then the odd ones whose even
-/// neighbours are done); the chunk size changes the schedule, not a bit of the results.
+/// The contact stage takes the layers chunk by chunk (even tasks, then the odd ones whose
+/// even neighbours are done, each layer's wall contacts with the task that writes it last),
+/// and past the cache size each task prefetches the next one's data; the chunk size and the
+/// prefetching change the schedule, not a bit of the results.
 #[test]
-fn the_pair_stage_gives_the_same_bits_whatever_its_chunks() {
-    use recorder::pipeline::pair_interactions_in_chunks;
+fn the_contact_stage_gives_the_same_bits_whatever_its_chunks_and_prefetching() {
+    use recorder::pipeline::contact_interactions_in_chunks;
 
     let before = turning_small_drum(2000, true);
     let layers = before.neighbors.layer_start.len() - 1;
     assert!(layers >= 8, "{layers} layers: too few for several chunks");
-    let stage = |chunk: u32| {
+    let stage = |chunk: u32, prefetch_above: usize| {
         let mut after = before.clone();
-        let pairs = pair_interactions_in_chunks(
+        let count = contact_interactions_in_chunks(
             &after.params,
             &mut after.particles,
             &mut after.neighbors,
+            &after.walls,
             chunk,
+            prefetch_above,
         );
         let p = &after.particles;
         let bits = |v: &[[f64; 3]]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
@@ -222,26 +230,32 @@ fn the_pair_stage_gives_the_same_bits_whatever_its_chunks() {
             .collect::<Vec<_>>();
         let heat = p.heat_flow.iter().map(|q| q.to_bits()).collect::<Vec<_>>();
         let touching = after.neighbors.touching.clone();
+        let wall_springs = after
+            .neighbors
+            .wall_history
+            .iter()
+            .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
+            .collect::<Vec<_>>();
+        let wall_touching = after.neighbors.wall_touching.clone();
         (
-            pairs,
-            bits(&p.force),
-            bits(&p.torque),
-            heat,
-            springs,
-            touching,
+            (count.pair_entries, count.wall),
+            (bits(&p.force), bits(&p.torque), heat),
+            (springs, touching),
+            (wall_springs, wall_touching),
         )
     };
     // one chunk for the whole drum, about two layers per chunk, and one in between
-    let whole = stage(u32::MAX);
+    let whole = stage(u32::MAX, usize::MAX);
+    let (pair_entries, wall) = whole.0;
     assert!(
-        whole.0 > 2000,
-        "the bed should be in contact: {} entries touch",
-        whole.0
+        pair_entries > 2000 && wall > 0,
+        "the bed should be in contact: {pair_entries} entries and {wall} wall candidates touch"
     );
-    for chunk in [1, 300, 900] {
+    for (chunk, prefetch_above) in [(1, usize::MAX), (300, 0), (900, usize::MAX), (900, 0)] {
         assert!(
-            stage(chunk) == whole,
-            "chunks of {chunk} particles changed the pair stage"
+            stage(chunk, prefetch_above) == whole,
+            "chunks of {chunk} particles, prefetching above {prefetch_above} bytes, changed \
+             the contact stage"
         );
     }
 }

@@ -3,7 +3,7 @@
 use crate::util::*;
 use recorder::integrate::update_temperatures;
 use recorder::particles::ParticleSet;
-use recorder::pipeline::pair_interactions;
+use recorder::pipeline::contact_interactions;
 
 #[test]
 fn pair_temperature_difference_decays_exponentially() {
@@ -35,9 +35,13 @@ fn pair_temperature_difference_decays_exponentially() {
     let mut worst: f64 = 0.0;
     with_threads(1, || {
         for step in 1..=5 * steps_per_tau {
-            let touching =
-                pair_interactions(&world.params, &mut world.particles, &mut world.neighbors);
-            assert_eq!(touching, 2);
+            let touching = contact_interactions(
+                &world.params,
+                &mut world.particles,
+                &mut world.neighbors,
+                &world.walls,
+            );
+            assert_eq!(touching.pair_entries, 2);
             update_temperatures(&mut world.particles, dt, HEAT_CAPACITY);
             if step % (steps_per_tau / 10) == 0 {
                 let t = step as f64 * dt;

@@ -7,10 +7,8 @@ use std::time::{Duration, Instant};
 pub struct Counters {
     /// Displacement check, re-sort and Verlet-list build.
     pub neighbor: Duration,
-    /// Sphere–sphere contact forces and conduction (one pass).
-    pub pair: Duration,
-    /// Sphere–wall contacts and heated-wall conduction.
-    pub wall: Duration,
+    /// Sphere–sphere and sphere–wall contact forces and conduction (one pass).
+    pub contact: Duration,
     /// Velocity-Verlet half steps and the temperature update.
     pub integrate: Duration,
     pub steps: u64,
@@ -19,15 +17,14 @@ pub struct Counters {
 
 impl Counters {
     pub fn total(&self) -> Duration {
-        self.neighbor + self.pair + self.wall + self.integrate
+        self.neighbor + self.contact + self.integrate
     }
 
     /// Stage names and times, in pipeline order.
-    pub fn stages(&self) -> [(&'static str, Duration); 4] {
+    pub fn stages(&self) -> [(&'static str, Duration); 3] {
         [
             ("neighbor", self.neighbor),
-            ("pair", self.pair),
-            ("wall", self.wall),
+            ("contact", self.contact),
             ("integrate", self.integrate),
         ]
     }

@@ -23,6 +23,7 @@ pub mod neighbor;
 pub mod output;
 pub mod particles;
 pub mod pipeline;
+pub mod prefetch;
 pub mod record;
 pub mod simulation;
 pub mod slices;

@@ -11,14 +11,13 @@ use crate::integrate;
 use crate::math::*;
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
+use crate::prefetch::{self, ArrayAddress, Prefetch};
 use crate::slices::for_each_task;
 use crate::wall::WallSet;
 use std::cell::RefCell;
 use std::ops::Range;
 
-/// Particles per parallel task in the wall stage.
-const BLOCK: usize = 1024;
-/// Particles per chunk of the pair stage's layers: a chunk's state and lists stay in the
+/// Particles per chunk of the contact stage's layers: a chunk's state and lists stay in the
 /// cache between its two phases.
 const CHUNK: u32 = 16384;
 
@@ -44,6 +43,16 @@ pub struct ContactCount {
     /// Particle–particle contacts seen from both sides (twice the number of pairs).
     pub pair_entries: u64,
     pub wall: u64,
+}
+
+impl std::ops::Add for ContactCount {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        Self {
+            pair_entries: self.pair_entries + other.pair_entries,
+            wall: self.wall + other.wall,
+        }
+    }
 }
 
 /// The step driver; holds the cell grid of the broad phase.
@@ -81,11 +90,8 @@ impl Pipeline {
                 neighbors.rebuild(particles, &self.grid, walls);
             }
         });
-        let pair_entries = timed(&mut counters.pair, || {
-            pair_interactions(params, particles, neighbors)
-        });
-        let wall = timed(&mut counters.wall, || {
-            wall_interactions(params, particles, neighbors, walls)
+        let contacts = timed(&mut counters.contact, || {
+            contact_interactions(params, particles, neighbors, walls)
         });
         timed(&mut counters.integrate, || {
             integrate::final_integrate(
@@ -97,33 +103,41 @@ impl Pipeline {
         });
         counters.steps += 1;
         counters.particle_steps += particles.len() as u64;
-        ContactCount { pair_entries, wall }
+        contacts
     }
 }
 
-/// Sphere–sphere forces, torques and conduction, each pair evaluated once from the half list.
+/// Sphere–sphere and sphere–wall forces, torques and conduction: each pair evaluated once
+/// from the half list, each wall candidate by the particle it belongs to.
 ///
 /// Layer `l` of the cell grid owns the pairs of its particles, whose partners lie in layer
 /// `l` or `l + 1`, so it writes only those two layers. Even layers run in parallel, then
 /// the odd ones (chunk by chunk, below): no two tasks write the same particle, and every
 /// particle receives its contributions in an order fixed by the list alone, so the sums do
-/// not depend on the thread count. Returns the touching pairs counted from both sides.
-pub fn pair_interactions(
+/// not depend on the thread count. The task that writes a layer last then adds its
+/// particles' wall contacts, while their state is still in the cache. Returns the touching
+/// pairs counted from both sides and the touching wall candidates.
+pub fn contact_interactions(
     params: &StepParams,
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
-) -> u64 {
-    pair_interactions_in_chunks(params, particles, neighbors, CHUNK)
+    walls: &WallSet,
+) -> ContactCount {
+    let cache = prefetch::last_level_cache_bytes();
+    contact_interactions_in_chunks(params, particles, neighbors, walls, CHUNK, cache)
 }
 
-/// [`pair_interactions`] with the layers taken in chunks of about `chunk` particles (the
-/// results do not depend on it).
-pub fn pair_interactions_in_chunks(
+/// [`contact_interactions`] with the layers taken in chunks of about `chunk` particles, and
+/// the next task's data prefetched when the state and lists take more than `prefetch_above`
+/// bytes (the results depend on neither).
+pub fn contact_interactions_in_chunks(
     params: &StepParams,
     particles: &mut ParticleSet,
     neighbors: &mut NeighborList,
+    walls: &WallSet,
     chunk: u32,
-) -> u64 {
+    prefetch_above: usize,
+) -> ContactCount {
     let ParticleSet {
         pos,
         vel,
@@ -144,15 +158,19 @@ pub fn pair_interactions_in_chunks(
         touching,
         layer_start,
         uniform_pair,
+        wall_offsets,
+        wall_index,
+        wall_history,
+        wall_touching,
         ..
     } = neighbors;
     let layers = layer_start.len().saturating_sub(1);
     if layers == 0 {
-        // no list yet: no pairs, and no task to start the sums below
+        // no list yet: no contacts, and no task to start the sums below
         force.fill([0.0; 3]);
         torque.fill([0.0; 3]);
         heat_flow.fill(0.0);
-        return 0;
+        return ContactCount::default();
     }
     let spheres = SphereArrays {
         pos,
@@ -168,14 +186,70 @@ pub fn pair_interactions_in_chunks(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
-    // the task of layer l writes the slots of l and l + 1 and the entries of l, from the
-    // start of its pieces (which reach the next task's start; it touches only those)
+    let wall_stage = WallStage {
+        walls,
+        law: &params.particle_wall,
+        heat: &params.conduction,
+        dt: params.dt,
+        offsets: wall_offsets,
+        index: wall_index,
+    };
+    // Past the cache size, each task prefetches what the next task of its phase on the same
+    // thread (layer l + 2, its partners in l + 3) will read, spread over its own work
+    let ahead = {
+        let state = pos.len() * (5 * size_of::<Vec3>() + 4 * size_of::<f64>());
+        let list = partners.len() * (size_of::<u32>() + size_of::<bool>())
+            + history.len() * size_of::<ContactHistory>();
+        (state + list > prefetch_above).then(|| {
+            let slot_arrays = [
+                ArrayAddress::of(pos),
+                ArrayAddress::of(vel),
+                ArrayAddress::of(omega),
+                ArrayAddress::of(radius),
+                ArrayAddress::of(mass),
+                ArrayAddress::of(temp),
+                ArrayAddress::of(force),
+                ArrayAddress::of(torque),
+                ArrayAddress::of(heat_flow),
+                ArrayAddress::of(offsets),
+            ];
+            let entry_arrays = [ArrayAddress::of(partners), ArrayAddress::of(touching)];
+            (slot_arrays, entry_arrays, ArrayAddress::of(history))
+        })
+    };
+    // (`touching_share`: the touching entries' share in layer l, taken for l + 2's too)
+    let prefetch_next = |l: usize, touching_share: f64| {
+        let mut next = Prefetch::default();
+        let Some((slot_arrays, [partner_array, touching_array], history_array)) = ahead else {
+            return next;
+        };
+        if l + 2 >= layers {
+            return next;
+        }
+        let slots = layer_start[l + 2] as usize..layer_start[(l + 4).min(layers)] as usize;
+        for array in slot_arrays {
+            next.add(array, slots.clone());
+        }
+        let first = offsets[slots.start] as usize;
+        let own = offsets[layer_start[l + 3] as usize] as usize - first;
+        next.add(partner_array, first..first + own);
+        next.add(touching_array, first..first + own);
+        // the packed histories of the touching entries only, whose count is known only once
+        // the next task has counted its flags
+        let histories = (own as f64 * touching_share).ceil() as usize;
+        next.add(history_array, first..first + histories);
+        next
+    };
+    // the task of layer l writes the slots of l and l + 1, the entries of l and the wall
+    // candidates of the layers it finishes (below), from the start of its pieces (which
+    // reach the next task's start; it touches only those)
     let start = |l: usize| {
         let s = layer_start[l] as usize;
         let e = offsets[s] as usize;
-        ((s, s), (s, (e, e)))
+        let w = wall_offsets[s] as usize;
+        ((s, s), (s, ((e, e), (w, w))))
     };
-    let layer_task = |l: usize, ((f, t), (q, (h, touch))): Accumulators| {
+    let layer_task = |l: usize, ((f, t), (q, ((h, touch), wall_pieces))): Accumulators| {
         let first_slot = layer_start[l] as usize;
         let first_entry = offsets[first_slot] as usize;
         if l.is_multiple_of(2) {
@@ -189,6 +263,7 @@ pub fn pair_interactions_in_chunks(
         }
         let slots = first_slot..layer_start[l + 1] as usize;
         let layer_entries = offsets[slots.end] as usize - first_entry;
+
         // the layer's histories are packed: those of its touching entries, in entry
         // order, from its first entry on (the stream the stage reads is the contacts',
         // not the list's)
@@ -196,7 +271,9 @@ pub fn pair_interactions_in_chunks(
             .iter()
             .map(|&t| usize::from(t))
             .sum::<usize>();
-        OLD_HISTORIES.with_borrow_mut(|old| {
+        let mut next = prefetch_next(l, touched as f64 / layer_entries.max(1) as f64);
+        let owners = slots.len().max(1) as f64;
+        let pair_entries = OLD_HISTORIES.with_borrow_mut(|old| {
             old.clear();
             old.extend_from_slice(&h[..touched]);
             old.push(ContactHistory::default());
@@ -206,7 +283,7 @@ pub fn pair_interactions_in_chunks(
             // is fixed by the list alone
             let mut owner = Owner::default();
             let entries = ListEntries {
-                slots,
+                slots: slots.clone(),
                 offsets,
                 partners,
                 first_entry,
@@ -215,22 +292,43 @@ pub fn pair_interactions_in_chunks(
             let mut evaluate = |batch: &mut PairBatch| {
                 batch.evaluate(&constants, &spheres, old, h);
                 owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
+                next.advance((owner.slot.wrapping_sub(first_slot) + 1) as f64 / owners);
             };
             let touching_pairs =
                 narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
             // the batch holds fewer than a full batch's contacts now: one evaluation
             evaluate(&mut batch);
-            owner.add_to((f, t, q), first_slot);
+            owner.add_to((&mut *f, &mut *t, &mut *q), first_slot);
             touching_pairs
-        })
+        });
+        // the odd task of layer l is the last to write layers l and l + 1, the even task of
+        // layer 0 the only one to write it: wall terms come after every pair term
+        let finished = if !l.is_multiple_of(2) {
+            first_slot..layer_start[(l + 2).min(layers)] as usize
+        } else if l == 0 {
+            slots
+        } else {
+            first_slot..first_slot
+        };
+        let wall = wall_stage.add(&spheres, finished, first_slot, (f, t, q), wall_pieces);
+        ContactCount {
+            pair_entries: 2 * pair_entries,
+            wall,
+        }
     };
     // task k of a phase owns layer l = phase + 2k (its pieces reach the next task's start)
     let mut run = |phase: usize, tasks: Range<usize>| {
         let arrays = (
             (&mut force[..], &mut torque[..]),
-            (&mut heat_flow[..], (&mut history[..], &mut touching[..])),
+            (
+                &mut heat_flow[..],
+                (
+                    (&mut history[..], &mut touching[..]),
+                    (&mut wall_history[..], &mut wall_touching[..]),
+                ),
+            ),
         );
-        let origin = ((0, 0), (0, (0, 0)));
+        let origin = ((0, 0), (0, ((0, 0), (0, 0))));
         let layer = |k: usize| phase + 2 * k;
         let work = |k: usize, pieces: Accumulators| layer_task(layer(k), pieces);
         for_each_task(arrays, origin, tasks, &|k| start(layer(k)), &work)
@@ -242,24 +340,24 @@ pub fn pair_interactions_in_chunks(
     // tasks, then the odd tasks whose two even neighbours are done; the chunk's last odd
     // layer waits for the next chunk's first even one. Same tasks, same order of every sum.
     let odd_tasks = layers.saturating_sub(1).div_ceil(2);
-    let (mut pairs, mut first, mut odd_done) = (0, 0, 0);
+    let (mut count, mut first, mut odd_done) = (ContactCount::default(), 0, 0);
     while first < layers {
         let mut end = first + 2;
         while end < layers && (layer_start[end] - layer_start[first]) < chunk {
             end += 2;
         }
         let end = end.min(layers);
-        pairs += run(0, first / 2..end.div_ceil(2));
+        count = count + run(0, first / 2..end.div_ceil(2));
         let odd_ready = if end == layers {
             odd_tasks
         } else {
             end / 2 - 1
         };
-        pairs += run(1, odd_done..odd_ready);
+        count = count + run(1, odd_done..odd_ready);
         odd_done = odd_ready;
         first = end;
     }
-    2 * pairs
+    count
 }
 
 /// The sums of the particle whose contacts the pair stage is handing out.
@@ -324,70 +422,45 @@ impl Owner {
     }
 }
 
-/// A task's force, torque, heat-flow, history and touching pieces.
+/// A task's force, torque and heat-flow pieces, its histories and touching flags, and the
+/// same for its wall candidates.
 type Accumulators<'a> = (
     (&'a mut [Vec3], &'a mut [Vec3]),
-    (&'a mut [f64], (&'a mut [ContactHistory], &'a mut [bool])),
+    (&'a mut [f64], (ListPieces<'a>, ListPieces<'a>)),
 );
 
-/// Sphere–wall forces and heated-wall conduction over the wall candidates of the list,
-/// added to the pair results (each particle writes only its own sums).
-pub fn wall_interactions(
-    params: &StepParams,
-    particles: &mut ParticleSet,
-    neighbors: &mut NeighborList,
-    walls: &WallSet,
-) -> u64 {
-    let n = particles.len();
-    if walls.is_empty() || n == 0 {
-        return 0;
-    }
-    let ParticleSet {
-        pos,
-        vel,
-        omega,
-        force,
-        torque,
-        radius,
-        mass,
-        temp,
-        heat_flow,
-        ..
-    } = particles;
-    let (pos, vel, omega, radius, mass, temp) = (&*pos, &*vel, &*omega, &*radius, &*mass, &*temp);
-    let NeighborList {
-        wall_offsets,
-        wall_index,
-        wall_history,
-        wall_touching,
-        ..
-    } = neighbors;
-    let wall_offsets = &*wall_offsets;
-    let wall_index = &*wall_index;
-    let dt = params.dt;
-    let (law, heat) = (&params.particle_wall, &params.conduction);
-    // task b owns the slots of block b and their wall candidates
-    let start = |b: usize| {
-        let first = b * BLOCK;
-        let w = wall_offsets[first] as usize;
-        ((first, first), (first, (w, w)))
-    };
-    let arrays = (
-        (&mut force[..], &mut torque[..]),
-        (
-            &mut heat_flow[..],
-            (&mut wall_history[..], &mut wall_touching[..]),
-        ),
-    );
-    let work = |b: usize, ((f, t), (q, (h, touch))): Accumulators| {
-        let first_slot = b * BLOCK;
-        let first_entry = wall_offsets[first_slot] as usize;
+/// Histories and touching flags of a task's list entries.
+type ListPieces<'a> = (&'a mut [ContactHistory], &'a mut [bool]);
+
+/// Sphere–wall forces and heated-wall conduction over the wall candidates of the list.
+struct WallStage<'a> {
+    walls: &'a WallSet,
+    law: &'a PairLaw,
+    heat: &'a ConductionLaw,
+    dt: f64,
+    offsets: &'a [u32],
+    index: &'a [u8],
+}
+
+impl WallStage<'_> {
+    /// Adds the wall contacts of `slots` to their sums; the sum pieces start at slot
+    /// `first_slot`, the wall pieces at its first candidate. Returns the touching ones.
+    #[inline(always)]
+    fn add(
+        &self,
+        spheres: &SphereArrays,
+        slots: Range<usize>,
+        first_slot: usize,
+        (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]),
+        (h, touch): ListPieces,
+    ) -> u64 {
+        let first_entry = self.offsets[first_slot] as usize;
         let mut touching = 0;
-        for il in 0..f.len() {
-            let i = first_slot + il;
-            for e in wall_offsets[i] as usize..wall_offsets[i + 1] as usize {
-                let (w, local) = (wall_index[e] as usize, e - first_entry);
-                let Some(c) = walls.contact(w, pos[i], radius[i]) else {
+        for i in slots {
+            let il = i - first_slot;
+            for e in self.offsets[i] as usize..self.offsets[i + 1] as usize {
+                let (w, local) = (self.index[e] as usize, e - first_entry);
+                let Some(c) = self.walls.contact(w, spheres.pos[i], spheres.radius[i]) else {
                     if touch[local] {
                         h[local] = ContactHistory::default();
                         touch[local] = false;
@@ -395,25 +468,24 @@ pub fn wall_interactions(
                     continue;
                 };
                 let si = SphereState {
-                    pos: pos[i],
-                    vel: vel[i],
-                    omega: omega[i],
-                    radius: radius[i],
-                    mass: mass[i],
+                    pos: spheres.pos[i],
+                    vel: spheres.vel[i],
+                    omega: spheres.omega[i],
+                    radius: spheres.radius[i],
+                    mass: spheres.mass[i],
                 };
                 let (kin, lever) = sphere_wall::kinematics(&si, &c);
-                let resp = hertz_mindlin::respond(law, &kin, &mut h[local], dt);
+                let resp = hertz_mindlin::respond(self.law, &kin, &mut h[local], self.dt);
                 touch[local] = true;
                 f[il] = add(f[il], resp.force);
                 t[il] = add(t[il], resp.torque_on_i(lever));
-                if let Some(tw) = walls.temperature(w) {
-                    q[il] += heat.wall_conductance(c.overlap, si.radius) * (tw - temp[i]);
+                if let Some(tw) = self.walls.temperature(w) {
+                    q[il] +=
+                        self.heat.wall_conductance(c.overlap, si.radius) * (tw - spheres.temp[i]);
                 }
                 touching += 1;
             }
         }
         touching
-    };
-    let tasks = 0..n.div_ceil(BLOCK);
-    for_each_task(arrays, ((0, 0), (0, (0, 0))), tasks, &start, &work)
+    }
 }

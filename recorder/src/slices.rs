@@ -1,7 +1,12 @@
 //! Parallel tasks that each own consecutive ranges of several arrays, handed out by
 //! splitting the arrays in halves (rayon::join) — safe, and without allocating.
 
-use std::ops::Range;
+use std::ops::{Add, Range};
+
+/// What tasks return: counts that add up.
+pub trait Sum: Send + Default + Add<Output = Self> {}
+
+impl<T: Send + Default + Add<Output = T>> Sum for T {}
 
 /// Mutable arrays that split together: a slice, or a pair of them (nest pairs for more).
 pub trait Pieces: Sized + Send {
@@ -27,32 +32,33 @@ impl<A: Pieces, B: Pieces> Pieces for (A, B) {
     }
 }
 
-/// Runs `work(task, pieces)` for every task of `tasks`, in parallel, and sums the results.
+/// Runs `work(task, pieces)` for every task of `tasks`, in parallel, and sums the results
+/// (from `R::default()`).
 /// Task `k`'s pieces start at `start(k)` and reach the next task's start (the last task's,
 /// the arrays' end); `start` must not decrease and `origin` is where the arrays begin.
 /// What a task does with its pieces does not depend on how the tasks were shared out.
-pub fn for_each_task<P: Pieces>(
+pub fn for_each_task<P: Pieces, R: Sum>(
     arrays: P,
     origin: P::At,
     tasks: Range<usize>,
     start: &(impl Fn(usize) -> P::At + Sync),
-    work: &(impl Fn(usize, P) -> u64 + Sync),
-) -> u64 {
+    work: &(impl Fn(usize, P) -> R + Sync),
+) -> R {
     if tasks.is_empty() {
-        return 0;
+        return R::default();
     }
     let first = start(tasks.start);
     let (_, pieces) = arrays.split(origin, first);
     split_tasks(pieces, first, tasks, start, work)
 }
 
-fn split_tasks<P: Pieces>(
+fn split_tasks<P: Pieces, R: Sum>(
     pieces: P,
     from: P::At,
     tasks: Range<usize>,
     start: &(impl Fn(usize) -> P::At + Sync),
-    work: &(impl Fn(usize, P) -> u64 + Sync),
-) -> u64 {
+    work: &(impl Fn(usize, P) -> R + Sync),
+) -> R {
     if tasks.len() == 1 {
         return work(tasks.start, pieces);
     }
@@ -76,7 +82,7 @@ mod tests {
         let mut b: Vec<u32> = (100..120).collect();
         // task k owns a[2k + 1 ..] and b[4k ..], up to the next task's start
         let seen = std::sync::Mutex::new(Vec::new());
-        let total = for_each_task(
+        let total: u64 = for_each_task(
             (&mut a[..], &mut b[..]),
             (0, 0),
             0..4,

@@ -30,8 +30,9 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Format of the body; a reader refuses others. v2: the Verlet list's pair histories are
-/// packed layer by layer (v1 had one per entry).
-pub const CHECKPOINT_VERSION: u32 = 2;
+/// packed layer by layer (v1 had one per entry). v3: one stage timer for pair and wall
+/// contacts (`contact`) instead of `pair` and `wall`.
+pub const CHECKPOINT_VERSION: u32 = 3;
 const HEADER_PREFIX: &str = "tdex checkpoint v";
 /// The header line is at most this long (a reader does not scan a large file for it).
 const MAX_HEADER: usize = 512;
