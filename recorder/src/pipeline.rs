@@ -263,7 +263,6 @@ pub fn contact_interactions_in_chunks(
         }
         let slots = first_slot..layer_start[l + 1] as usize;
         let layer_entries = offsets[slots.end] as usize - first_entry;
-
         // the layer's histories are packed: those of its touching entries, in entry
         // order, from its first entry on (the stream the stage reads is the contacts',
         // not the list's)
@@ -292,7 +291,10 @@ pub fn contact_interactions_in_chunks(
             let mut evaluate = |batch: &mut PairBatch| {
                 batch.evaluate(&constants, &spheres, old, h);
                 owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
-                next.advance((owner.slot.wrapping_sub(first_slot) + 1) as f64 / owners);
+                // (no owner yet only when a layer without contacts hands out its empty batch)
+                if owner.slot != usize::MAX {
+                    next.advance((owner.slot + 1 - first_slot) as f64 / owners);
+                }
             };
             let touching_pairs =
                 narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
