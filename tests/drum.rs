@@ -205,6 +205,7 @@ fn each_pair_once_equals_each_particle_summing_its_own_contacts() {
 /// prefetching change the schedule, not a bit of the results.
 #[test]
 fn the_contact_stage_gives_the_same_bits_whatever_its_chunks_and_prefetching() {
+    use recorder::contact::ContactHistory;
     use recorder::pipeline::contact_interactions_in_chunks;
 
     let before = turning_small_drum(2000, true);
@@ -222,20 +223,16 @@ fn the_contact_stage_gives_the_same_bits_whatever_its_chunks_and_prefetching() {
         );
         let p = &after.particles;
         let bits = |v: &[[f64; 3]]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
-        let springs = after
-            .neighbors
-            .histories_by_entry()
-            .iter()
-            .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
-            .collect::<Vec<_>>();
+        let spring_bits = |histories: &[ContactHistory]| {
+            histories
+                .iter()
+                .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
+                .collect::<Vec<_>>()
+        };
+        let springs = spring_bits(&after.neighbors.histories_by_entry());
         let heat = p.heat_flow.iter().map(|q| q.to_bits()).collect::<Vec<_>>();
         let touching = after.neighbors.touching.clone();
-        let wall_springs = after
-            .neighbors
-            .wall_history
-            .iter()
-            .map(|h| (h.shear.map(f64::to_bits), h.roll.map(f64::to_bits)))
-            .collect::<Vec<_>>();
+        let wall_springs = spring_bits(&after.neighbors.wall_history);
         let wall_touching = after.neighbors.wall_touching.clone();
         (
             (count.pair_entries, count.wall),

@@ -186,7 +186,7 @@ pub fn contact_interactions_in_chunks(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
-    let wall_stage = WallStage {
+    let wall_contacts = WallContacts {
         walls,
         law: &params.particle_wall,
         heat: &params.conduction,
@@ -194,52 +194,28 @@ pub fn contact_interactions_in_chunks(
         offsets: wall_offsets,
         index: wall_index,
     };
-    // Past the cache size, each task prefetches what the next task of its phase on the same
-    // thread (layer l + 2, its partners in l + 3) will read, spread over its own work
-    let ahead = {
-        let state = pos.len() * (5 * size_of::<Vec3>() + 4 * size_of::<f64>());
-        let list = partners.len() * (size_of::<u32>() + size_of::<bool>())
-            + history.len() * size_of::<ContactHistory>();
-        (state + list > prefetch_above).then(|| {
-            let slot_arrays = [
-                ArrayAddress::of(pos),
-                ArrayAddress::of(vel),
-                ArrayAddress::of(omega),
-                ArrayAddress::of(radius),
-                ArrayAddress::of(mass),
-                ArrayAddress::of(temp),
-                ArrayAddress::of(force),
-                ArrayAddress::of(torque),
-                ArrayAddress::of(heat_flow),
-                ArrayAddress::of(offsets),
-            ];
-            let entry_arrays = [ArrayAddress::of(partners), ArrayAddress::of(touching)];
-            (slot_arrays, entry_arrays, ArrayAddress::of(history))
-        })
-    };
-    // (`touching_share`: the touching entries' share in layer l, taken for l + 2's too)
-    let prefetch_next = |l: usize, touching_share: f64| {
-        let mut next = Prefetch::default();
-        let Some((slot_arrays, [partner_array, touching_array], history_array)) = ahead else {
-            return next;
-        };
-        if l + 2 >= layers {
-            return next;
-        }
-        let slots = layer_start[l + 2] as usize..layer_start[(l + 4).min(layers)] as usize;
-        for array in slot_arrays {
-            next.add(array, slots.clone());
-        }
-        let first = offsets[slots.start] as usize;
-        let own = offsets[layer_start[l + 3] as usize] as usize - first;
-        next.add(partner_array, first..first + own);
-        next.add(touching_array, first..first + own);
-        // the packed histories of the touching entries only, whose count is known only once
-        // the next task has counted its flags
-        let histories = (own as f64 * touching_share).ceil() as usize;
-        next.add(history_array, first..first + histories);
-        next
-    };
+    // past the cache size, each task prefetches what the next task of its phase on the same
+    // thread will read, spread over its own work
+    let state = pos.len() * (5 * size_of::<Vec3>() + 4 * size_of::<f64>());
+    let list = partners.len() * (size_of::<u32>() + size_of::<bool>())
+        + history.len() * size_of::<ContactHistory>();
+    let ahead = (state + list > prefetch_above).then(|| TaskArrays {
+        per_slot: [
+            ArrayAddress::of(pos),
+            ArrayAddress::of(vel),
+            ArrayAddress::of(omega),
+            ArrayAddress::of(radius),
+            ArrayAddress::of(mass),
+            ArrayAddress::of(temp),
+            ArrayAddress::of(force),
+            ArrayAddress::of(torque),
+            ArrayAddress::of(heat_flow),
+            ArrayAddress::of(offsets),
+        ],
+        partners: ArrayAddress::of(partners),
+        touching: ArrayAddress::of(touching),
+        histories: ArrayAddress::of(history),
+    });
     // the task of layer l writes the slots of l and l + 1, the entries of l and the wall
     // candidates of the layers it finishes (below), from the start of its pieces (which
     // reach the next task's start; it touches only those)
@@ -270,7 +246,13 @@ pub fn contact_interactions_in_chunks(
             .iter()
             .map(|&t| usize::from(t))
             .sum::<usize>();
-        let mut next = prefetch_next(l, touched as f64 / layer_entries.max(1) as f64);
+        let mut next = match &ahead {
+            Some(arrays) if l + 2 < layers => {
+                let share = touched as f64 / layer_entries.max(1) as f64;
+                arrays.prefetch(l + 2, layer_start, offsets, share)
+            }
+            _ => Prefetch::default(),
+        };
         let owners = slots.len().max(1) as f64;
         let pair_entries = OLD_HISTORIES.with_borrow_mut(|old| {
             old.clear();
@@ -312,7 +294,7 @@ pub fn contact_interactions_in_chunks(
         } else {
             first_slot..first_slot
         };
-        let wall = wall_stage.add(&spheres, finished, first_slot, (f, t, q), wall_pieces);
+        let wall = wall_contacts.add(&spheres, finished, first_slot, (f, t, q), wall_pieces);
         ContactCount {
             pair_entries: 2 * pair_entries,
             wall,
@@ -434,8 +416,44 @@ type Accumulators<'a> = (
 /// Histories and touching flags of a task's list entries.
 type ListPieces<'a> = (&'a mut [ContactHistory], &'a mut [bool]);
 
+/// Where the arrays a pair task reads lie, for prefetching the next task's part of them.
+struct TaskArrays {
+    /// Indexed by slot: the state, the sums and the list offsets.
+    per_slot: [ArrayAddress; 10],
+    partners: ArrayAddress,
+    touching: ArrayAddress,
+    histories: ArrayAddress,
+}
+
+impl TaskArrays {
+    /// What the task of layer `l` reads: the slots of `l` and `l + 1` (its partners'), the
+    /// entries of `l`, and their packed histories, as many as `touching_share` of the
+    /// entries (their count is known only once that task has counted its flags).
+    fn prefetch(
+        &self,
+        l: usize,
+        layer_start: &[u32],
+        offsets: &[u32],
+        touching_share: f64,
+    ) -> Prefetch {
+        let layers = layer_start.len() - 1;
+        let slots = layer_start[l] as usize..layer_start[(l + 2).min(layers)] as usize;
+        let mut next = Prefetch::default();
+        for array in self.per_slot {
+            next.add(array, slots.clone());
+        }
+        let first = offsets[slots.start] as usize;
+        let entries = offsets[layer_start[l + 1] as usize] as usize - first;
+        next.add(self.partners, first..first + entries);
+        next.add(self.touching, first..first + entries);
+        let histories = (entries as f64 * touching_share).ceil() as usize;
+        next.add(self.histories, first..first + histories);
+        next
+    }
+}
+
 /// Sphere–wall forces and heated-wall conduction over the wall candidates of the list.
-struct WallStage<'a> {
+struct WallContacts<'a> {
     walls: &'a WallSet,
     law: &'a PairLaw,
     heat: &'a ConductionLaw,
@@ -444,7 +462,7 @@ struct WallStage<'a> {
     index: &'a [u8],
 }
 
-impl WallStage<'_> {
+impl WallContacts<'_> {
     /// Adds the wall contacts of `slots` to their sums; the sum pieces start at slot
     /// `first_slot`, the wall pieces at its first candidate. Returns the touching ones.
     #[inline(always)]
