@@ -169,10 +169,78 @@ fn compare_refuses_files_in_the_wrong_places() {
         err.contains(extra_s) && err.contains("not a tdex recording"),
         "{err}"
     );
-    let o = run_tdex(&["compare", run_s, run_s]);
-    assert_eq!(o.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("not a tdex extrapolation"));
     let o = run_tdex(&["compare", run_s, extra_s, "--cells", "0"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("--cells"));
+}
+
+/// Records the tiny case (with `seed`) for one τ of 0.5 s (or `tau_rev` of a revolution)
+/// and `reference` more, into `dir/name`.
+fn record_tiny(dir: &Path, name: &str, seed: u32, period: [&str; 2], reference: u32) -> PathBuf {
+    let case = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &case,
+        TINY_CASE.replace("seed = 5", &format!("seed = {seed}")),
+    )
+    .unwrap();
+    let out = dir.join(format!("{name}.mcap"));
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        period[0],
+        period[1],
+        "--reference",
+        &reference.to_string(),
+    ]);
+    out
+}
+
+#[test]
+fn a_second_dem_run_is_compared_on_its_own_particles() {
+    let dir = tempfile::tempdir().unwrap();
+    let a = record_tiny(dir.path(), "a", 5, ["--tau", "0.5"], 2);
+    let b = record_tiny(dir.path(), "b", 6, ["--tau", "0.5"], 2);
+    let (a_s, b_s) = (a.to_str().unwrap(), b.to_str().unwrap());
+    let json = |x: &str, y: &str| -> serde_json::Value {
+        serde_json::from_str(&tdex_ok(&["compare", x, y, "--cells", "20", "--json"])).unwrap()
+    };
+    let (ab, aa, bb) = (json(a_s, b_s), json(a_s, a_s), json(b_s, b_s));
+    assert_eq!(ab["second"], "dem");
+    let ks = |v: &serde_json::Value| -> Vec<u64> {
+        v["periods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["k"].as_u64().unwrap())
+            .collect()
+    };
+    // A second run is compared from t1 on: it is not the recording's DEM there.
+    assert_eq!(ks(&ab), vec![1, 2, 3]);
+    for k in 0..3 {
+        let (pab, paa, pbb) = (&ab["periods"][k], &aa["periods"][k], &bb["periods"][k]);
+        // A run against itself: nothing apart.
+        assert_eq!(paa["eps_abs"].as_f64(), Some(0.0), "{paa}");
+        assert_eq!(paa["energy_error"].as_f64(), Some(0.0), "{paa}");
+        assert_eq!(paa["hot_mean_extra"], paa["hot_mean_dem"]);
+        // Another packing: apart in the cells, and its group means are those of its own
+        // hot and cold particles, not of the particles with the recording's ids.
+        assert!(pab["eps_abs"].as_f64().unwrap() > 0.0, "{pab}");
+        assert_eq!(pab["hot_mean_extra"], pbb["hot_mean_dem"]);
+        assert_eq!(pab["cold_mean_extra"], pbb["cold_mean_dem"]);
+        assert_eq!(pab["hot_mean_dem"], paa["hot_mean_dem"]);
+    }
+    let table = tdex_ok(&["compare", a_s, b_s, "--cells", "20"]);
+    assert!(table.starts_with("second DEM run"), "{table}");
+
+    // Other instants (τ half a revolution of 2 s: t1 at 1 s after t0, not 0.5 s) are refused.
+    let c = record_tiny(dir.path(), "c", 5, ["--tau-rev", "0.5"], 1);
+    let o = run_tdex(&["compare", a_s, c.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("same instants") && err.contains(c.to_str().unwrap()),
+        "{err}"
+    );
 }

@@ -107,10 +107,13 @@ pub enum Command {
     },
     /// Compare an extrapolation with the recording's DEM reference at every t_k: Voronoi-cell
     /// errors (eps_abs, eps_rel), the Eq. 10 energy-transfer error, hot/cold group means.
+    /// Given a second recording instead, compare two DEM runs of one case the same way.
     Compare {
         /// The recording, made with --reference K.
         recording: PathBuf,
-        /// The extrapolation of that recording.
+        /// The extrapolation of that recording; or a second DEM run of the same case, recorded
+        /// with a reference over the same t_k (another seed, a perturbed case, a LIGGGHTS
+        /// import), to see how far apart two DEM runs are on the same measures.
         extrapolation: PathBuf,
         /// Voronoi cells (seeds drawn inside the bed).
         #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]

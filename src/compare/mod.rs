@@ -1,5 +1,6 @@
 //! `tdex compare`: the extrapolation against the DEM reference at every `t_k` (DESIGN.md
-//! §7): Voronoi-cell errors, the Eq. 10 energy-transfer error, hot/cold group means.
+//! §7): Voronoi-cell errors, the Eq. 10 energy-transfer error, hot/cold group means. The
+//! same measures between two DEM runs of one case give the floor no extrapolation can beat.
 
 pub mod metrics;
 
@@ -7,7 +8,7 @@ use crate::cli::ComparePlan;
 use crate::cli::UsageError;
 use anyhow::{Context, Result};
 use metrics::Cells;
-use recorder::format::{ExtrapolationReader, RecordingReader, Snapshot};
+use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 use serde::Serialize;
 
 /// Default number of Voronoi cells (the paper's v = 200).
@@ -15,11 +16,35 @@ pub const DEFAULT_CELLS: usize = 200;
 /// Default seed of the cell seeds.
 pub const DEFAULT_SEED: u64 = 1;
 
-/// The comparison of one extrapolation with its recording's DEM reference.
+/// What the recording's DEM reference is compared with.
+#[derive(Debug, Clone, Copy)]
+pub enum Second<'a> {
+    /// An extrapolation of the recording: roles at their `t1` positions, each carrying the
+    /// id of one of the recording's particles.
+    Extrapolation(&'a ExtrapolationReader),
+    /// A second DEM run of the same case over the same `t_k` (another seed, a perturbed
+    /// case, a run imported from another engine): its own particles, positions and hot and
+    /// cold groups. Two runs of a chaotic flow part at the particle scale within a period,
+    /// so their errors are the floor an extrapolation is measured against.
+    Dem(&'a RecordingReader),
+}
+
+/// Which kind of file the second field came from (the JSON's `second`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SecondKind {
+    Extrapolation,
+    Dem,
+}
+
+/// The comparison of one extrapolation (or second DEM run) with a recording's DEM
+/// reference. The `*_extra` fields hold the second field whichever kind it is.
 #[derive(Debug, Clone, Serialize)]
 pub struct Comparison {
     pub recording: String,
+    /// The second file: the extrapolation, or the second DEM run's recording.
     pub extrapolation: String,
+    pub second: SecondKind,
     pub particles: u32,
     /// Cells asked for and seed of their centres.
     pub cells: usize,
@@ -27,7 +52,8 @@ pub struct Comparison {
     /// Sizes of the initially hot and cold groups (0 if the bed started uniform).
     pub hot_particles: usize,
     pub cold_particles: usize,
-    /// One entry per extrapolated `t_k` that has a DEM reference (k ≥ 2).
+    /// One entry per extrapolated `t_k` that has a DEM reference (k ≥ 2; k ≥ 1 against a
+    /// second DEM run).
     pub periods: Vec<PeriodComparison>,
     /// Group means of every DEM snapshot (k = 0, 1, then the reference), for plots.
     pub dem_series: Vec<GroupMeans>,
@@ -72,8 +98,16 @@ macro_rules! refuse {
 
 pub fn run(plan: &ComparePlan) -> Result<()> {
     let recording = RecordingReader::open(&plan.recording)?;
-    let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
-    let c = compare(&recording, &extrapolation, plan.cells, plan.seed)?;
+    // A file without recording metadata is read as an extrapolation, whose reader then
+    // names what is missing; any other fault of a recording is reported as it is.
+    let c = match RecordingReader::open(&plan.extrapolation) {
+        Ok(dem) => compare_with(&recording, Second::Dem(&dem), plan.cells, plan.seed)?,
+        Err(FormatError::NotRecording { .. }) => {
+            let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
+            compare(&recording, &extrapolation, plan.cells, plan.seed)?
+        }
+        Err(e) => return Err(e.into()),
+    };
     if plan.json {
         println!("{}", serde_json::to_string_pretty(&c)?);
     } else if plan.csv {
@@ -91,17 +125,41 @@ pub fn compare(
     cells: usize,
     seed: u64,
 ) -> Result<Comparison> {
+    compare_with(recording, Second::Extrapolation(extrapolation), cells, seed)
+}
+
+/// Compares the `second` field with the DEM reference snapshots of `recording`.
+pub fn compare_with(
+    recording: &RecordingReader,
+    second: Second,
+    cells: usize,
+    seed: u64,
+) -> Result<Comparison> {
     let rec_path = recording.path().display().to_string();
-    let extra_path = extrapolation.path().display().to_string();
-    if extrapolation.info().recording_info != *recording.info() {
-        refuse!(
-            "{extra_path} was not extrapolated from {rec_path} (it names {}, and the recordings' \
-             metadata differ)",
-            extrapolation.info().recording
-        );
-    }
     let dem = recording.snapshots()?;
-    let extra = extrapolation.snapshots()?;
+    let (extra_path, extra, kind) = match second {
+        Second::Extrapolation(extrapolation) => {
+            let extra_path = extrapolation.path().display().to_string();
+            if extrapolation.info().recording_info != *recording.info() {
+                refuse!(
+                    "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
+                     recordings' metadata differ)",
+                    extrapolation.info().recording
+                );
+            }
+            (
+                extra_path,
+                extrapolation.snapshots()?,
+                SecondKind::Extrapolation,
+            )
+        }
+        Second::Dem(twin) => {
+            let twin_path = twin.path().display().to_string();
+            let snaps = twin.snapshots()?;
+            check_same_instants(recording, &dem, &twin_path, twin, &snaps)?;
+            (twin_path, snaps, SecondKind::Dem)
+        }
+    };
     let dem_at = |k: u32| dem.iter().find(|s| s.index == k);
     let t0 = dem_at(0).with_context(|| format!("{rec_path}: no snapshot at t0"))?;
     let t1 = dem_at(1).with_context(|| format!("{rec_path}: no snapshot at t1"))?;
@@ -120,13 +178,23 @@ pub fn compare(
         );
     }
     let groups = metrics::hot_cold_groups(&t0.temp);
-    let means = |temps_by_id: &[f64]| match &groups {
+    // An extrapolation's ids are the recording's particles; a second run has its own, and
+    // its own hot and cold particles, chosen by the same rule at its own t0.
+    let extra_groups = match kind {
+        SecondKind::Extrapolation => groups.clone(),
+        SecondKind::Dem => extra
+            .iter()
+            .find(|s| s.index == 0)
+            .and_then(|s| metrics::hot_cold_groups(&metrics::by_id(&s.id, &s.temp))),
+    };
+    let means_in = |groups: &Option<(Vec<u32>, Vec<u32>)>, temps_by_id: &[f64]| match groups {
         Some((hot, cold)) => (
             Some(metrics::group_mean(temps_by_id, hot)),
             Some(metrics::group_mean(temps_by_id, cold)),
         ),
         None => (None, None),
     };
+    let means = |temps_by_id: &[f64]| means_in(&groups, temps_by_id);
     let by_id = |s: &Snapshot| metrics::by_id(&s.id, &s.temp);
 
     let dem_series = dem
@@ -142,8 +210,6 @@ pub fn compare(
         })
         .collect();
 
-    // The extrapolated positions are the roles' positions at t1: one cell assignment.
-    let mut extra_cells: Option<Vec<u32>> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
     for pair in extra.windows(2) {
@@ -153,14 +219,13 @@ pub fn compare(
             unreferenced.push(k);
             continue;
         };
-        let extra_cells = extra_cells.get_or_insert_with(|| cells_v.assign(&after.pos));
         let dem_means = cells_v.means(&dem_after.pos, &dem_after.temp);
-        let extra_means = metrics::cell_means(extra_cells, &after.temp, cells_v.len());
+        let extra_means = cells_v.means(&after.pos, &after.temp);
         let (eps_abs, cells_used) = metrics::eps_abs(&dem_means, &extra_means)
             .with_context(|| format!("t_{k}: no Voronoi cell holds particles of both fields"))?;
         let (hot_dem, cold_dem) = means(&dem_after.temp);
         let extra_after = by_id(after);
-        let (hot_extra, cold_extra) = means(&extra_after);
+        let (hot_extra, cold_extra) = means_in(&extra_groups, &extra_after);
         let scale = hot_dem.zip(cold_dem).map(|(h, c)| (h - c).abs());
         periods.push(PeriodComparison {
             k,
@@ -192,6 +257,7 @@ pub fn compare(
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,
+        second: kind,
         particles: recording.info().particles,
         cells: cells_v.len(),
         seed,
@@ -203,14 +269,57 @@ pub fn compare(
     })
 }
 
+/// A second DEM run is compared only with the same particle count and at the same instants:
+/// each of its snapshots that the recording also has must be within half a step of it.
+fn check_same_instants(
+    recording: &RecordingReader,
+    dem: &[Snapshot],
+    twin_path: &str,
+    twin: &RecordingReader,
+    twin_snaps: &[Snapshot],
+) -> Result<()> {
+    let rec_path = recording.path().display().to_string();
+    let (n, n_twin) = (recording.info().particles, twin.info().particles);
+    if n != n_twin {
+        refuse!(
+            "{twin_path} holds {n_twin} particles and {rec_path} {n}: two DEM runs are compared \
+             only with the same particle count"
+        );
+    }
+    let half_step = 0.5 * recording.info().dt;
+    for s in twin_snaps {
+        if let Some(d) = dem.iter().find(|d| d.index == s.index) {
+            if (d.time - s.time).abs() > half_step {
+                refuse!(
+                    "{twin_path}: its t_{k} is at {} s and {rec_path}'s at {} s; two DEM runs \
+                     are compared at the same instants (t0 and the period τ must agree to half \
+                     a step, {half_step} s)",
+                    s.time,
+                    d.time,
+                    k = s.index
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
 fn opt(x: Option<f64>, scale: f64, digits: usize) -> String {
     x.map_or("-".into(), |v| format!("{:.digits$}", v * scale))
 }
 
 /// The terminal table (Table 5 form, plus the group means).
 pub fn table(c: &Comparison) -> String {
+    let (hot, cold) = match c.second {
+        SecondKind::Extrapolation => ("hot extra", "cold ext"),
+        SecondKind::Dem => ("hot DEM 2", "cold DEM2"),
+    };
     let mut s = format!(
-        "{} vs {}: {} particles, {} Voronoi cells (seed {}), {} hot / {} cold\n",
+        "{}{} vs {}: {} particles, {} Voronoi cells (seed {}), {} hot / {} cold\n",
+        match c.second {
+            SecondKind::Extrapolation => "",
+            SecondKind::Dem => "second DEM run ",
+        },
         c.extrapolation,
         c.recording,
         c.particles,
@@ -221,15 +330,7 @@ pub fn table(c: &Comparison) -> String {
     );
     s += &format!(
         "{:>4} {:>9} {:>10} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
-        "k",
-        "t (s)",
-        "eps_abs K",
-        "eps_rel%",
-        "eq10 %",
-        "hot DEM",
-        "hot extra",
-        "cold DEM",
-        "cold ext"
+        "k", "t (s)", "eps_abs K", "eps_rel%", "eq10 %", "hot DEM", hot, "cold DEM", cold
     );
     for p in &c.periods {
         s += &format!(
