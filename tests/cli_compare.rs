@@ -174,8 +174,8 @@ fn compare_refuses_files_in_the_wrong_places() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--cells"));
 }
 
-/// Records the tiny case (with `seed`) for one τ of 0.5 s (or `tau_rev` of a revolution)
-/// and `reference` more, into `dir/name`.
+/// Records the tiny case with `seed` into `dir/name.mcap`: one period, given by the flag
+/// and value in `period` (`["--tau", "0.5"]`), and `reference` more.
 fn record_tiny(dir: &Path, name: &str, seed: u32, period: [&str; 2], reference: u32) -> PathBuf {
     let case = dir.join(format!("{name}.toml"));
     std::fs::write(
