@@ -210,6 +210,9 @@ pub fn compare_with(
         })
         .collect();
 
+    // The extrapolated positions are the roles' positions at t1: one cell assignment; a
+    // second DEM run moves, so each of its snapshots is assigned anew.
+    let mut role_cells: Option<Vec<u32>> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
     for pair in extra.windows(2) {
@@ -220,7 +223,17 @@ pub fn compare_with(
             continue;
         };
         let dem_means = cells_v.means(&dem_after.pos, &dem_after.temp);
-        let extra_means = cells_v.means(&after.pos, &after.temp);
+        let moved;
+        let extra_cells: &[u32] = match kind {
+            SecondKind::Extrapolation => {
+                role_cells.get_or_insert_with(|| cells_v.assign(&after.pos))
+            }
+            SecondKind::Dem => {
+                moved = cells_v.assign(&after.pos);
+                &moved
+            }
+        };
+        let extra_means = metrics::cell_means(extra_cells, &after.temp, cells_v.len());
         let (eps_abs, cells_used) = metrics::eps_abs(&dem_means, &extra_means)
             .with_context(|| format!("t_{k}: no Voronoi cell holds particles of both fields"))?;
         let (hot_dem, cold_dem) = means(&dem_after.temp);
