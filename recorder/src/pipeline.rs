@@ -196,10 +196,7 @@ pub fn contact_interactions_in_chunks(
     };
     // past the cache size, each task prefetches what the next task of its phase on the same
     // thread will read, spread over its own work
-    let state = pos.len() * (5 * size_of::<Vec3>() + 4 * size_of::<f64>());
-    let list = partners.len() * (size_of::<u32>() + size_of::<bool>())
-        + history.len() * size_of::<ContactHistory>();
-    let ahead = (state + list > prefetch_above).then(|| TaskArrays {
+    let task_arrays = TaskArrays {
         per_slot: [
             ArrayAddress::of(pos),
             ArrayAddress::of(vel),
@@ -215,7 +212,8 @@ pub fn contact_interactions_in_chunks(
         partners: ArrayAddress::of(partners),
         touching: ArrayAddress::of(touching),
         histories: ArrayAddress::of(history),
-    });
+    };
+    let ahead = (task_arrays.bytes() > prefetch_above).then_some(task_arrays);
     // the task of layer l writes the slots of l and l + 1, the entries of l and the wall
     // candidates of the layers it finishes (below), from the start of its pieces (which
     // reach the next task's start; it touches only those)
@@ -264,7 +262,7 @@ pub fn contact_interactions_in_chunks(
             // is fixed by the list alone
             let mut owner = Owner::default();
             let entries = ListEntries {
-                slots: slots.clone(),
+                slots,
                 offsets,
                 partners,
                 first_entry,
@@ -273,10 +271,7 @@ pub fn contact_interactions_in_chunks(
             let mut evaluate = |batch: &mut PairBatch| {
                 batch.evaluate(&constants, &spheres, old, h);
                 owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
-                // (no owner yet only when a layer without contacts hands out its empty batch)
-                if owner.slot != usize::MAX {
-                    next.advance((owner.slot + 1 - first_slot) as f64 / owners);
-                }
+                next.advance(owner.slots_done(first_slot) as f64 / owners);
             };
             let touching_pairs =
                 narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
@@ -285,15 +280,7 @@ pub fn contact_interactions_in_chunks(
             owner.add_to((&mut *f, &mut *t, &mut *q), first_slot);
             touching_pairs
         });
-        // the odd task of layer l is the last to write layers l and l + 1, the even task of
-        // layer 0 the only one to write it: wall terms come after every pair term
-        let finished = if !l.is_multiple_of(2) {
-            first_slot..layer_start[(l + 2).min(layers)] as usize
-        } else if l == 0 {
-            slots
-        } else {
-            first_slot..first_slot
-        };
+        let finished = finished_slots(l, layer_start);
         let wall = wall_contacts.add(&spheres, finished, first_slot, (f, t, q), wall_pieces);
         ContactCount {
             pair_entries: 2 * pair_entries,
@@ -342,6 +329,22 @@ pub fn contact_interactions_in_chunks(
         first = end;
     }
     count
+}
+
+/// The slots whose pair sums are complete once the task of layer `l` has run, so their wall
+/// terms can follow every pair term: the odd task of layer `l` is the last to write layers
+/// `l` and `l + 1`, the even task of layer 0 the only one to write layer 0; the other even
+/// tasks finish none.
+fn finished_slots(l: usize, layer_start: &[u32]) -> Range<usize> {
+    let layers = layer_start.len() - 1;
+    let first_slot = layer_start[l] as usize;
+    if !l.is_multiple_of(2) {
+        first_slot..layer_start[(l + 2).min(layers)] as usize
+    } else if l == 0 {
+        first_slot..layer_start[1] as usize
+    } else {
+        first_slot..first_slot
+    }
 }
 
 /// The sums of the particle whose contacts the pair stage is handing out.
@@ -394,6 +397,15 @@ impl Owner {
         batch.consume();
     }
 
+    /// Slots of a task starting at `first_slot` that its batches have reached, the owner's
+    /// included (0 before the first owner): the task's progress.
+    fn slots_done(&self, first_slot: usize) -> usize {
+        if self.slot == usize::MAX {
+            return 0;
+        }
+        self.slot + 1 - first_slot
+    }
+
     /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.
     fn add_to(&self, (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]), first_slot: usize) {
         if self.slot == usize::MAX {
@@ -426,6 +438,16 @@ struct TaskArrays {
 }
 
 impl TaskArrays {
+    /// Bytes of all these arrays: what must outgrow the cache for the prefetch to pay.
+    fn bytes(&self) -> usize {
+        let lists = [self.partners, self.touching, self.histories];
+        self.per_slot
+            .iter()
+            .chain(&lists)
+            .map(ArrayAddress::bytes)
+            .sum()
+    }
+
     /// What the task of layer `l` reads: the slots of `l` and `l + 1` (its partners'), the
     /// entries of `l`, and their packed histories, as many as `touching_share` of the
     /// entries (their count is known only once that task has counted its flags).

@@ -73,6 +73,10 @@ impl ArrayAddress {
             len: array.len(),
         }
     }
+
+    pub fn bytes(&self) -> usize {
+        self.len * self.element
+    }
 }
 
 /// Element ranges of several arrays, each prefetched up to the same fraction of its length
