@@ -154,10 +154,9 @@ pub fn compare_with(
             )
         }
         Second::Dem(twin) => {
-            let twin_path = twin.path().display().to_string();
             let snaps = twin.snapshots()?;
-            check_same_instants(recording, &dem, &twin_path, twin, &snaps)?;
-            (twin_path, snaps, SecondKind::Dem)
+            check_same_instants((recording, &dem), (twin, &snaps))?;
+            (twin.path().display().to_string(), snaps, SecondKind::Dem)
         }
     };
     let dem_at = |k: u32| dem.iter().find(|s| s.index == k);
@@ -285,13 +284,11 @@ pub fn compare_with(
 /// A second DEM run is compared only with the same particle count and at the same instants:
 /// each of its snapshots that the recording also has must be within half a step of it.
 fn check_same_instants(
-    recording: &RecordingReader,
-    dem: &[Snapshot],
-    twin_path: &str,
-    twin: &RecordingReader,
-    twin_snaps: &[Snapshot],
+    (recording, dem): (&RecordingReader, &[Snapshot]),
+    (twin, twin_snaps): (&RecordingReader, &[Snapshot]),
 ) -> Result<()> {
     let rec_path = recording.path().display().to_string();
+    let twin_path = twin.path().display().to_string();
     let (n, n_twin) = (recording.info().particles, twin.info().particles);
     if n != n_twin {
         refuse!(
