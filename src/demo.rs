@@ -1,5 +1,6 @@
 //! `tdex demo`: the whole method end to end on the built-in small drum — record one
-//! revolution with a six-period DEM reference, extrapolate six periods, compare, report.
+//! revolution with a six-period DEM reference and one DEM twin (the DEM's own spread),
+//! extrapolate six periods, compare, report, and say how far to trust the prediction.
 
 use crate::cli::{DemoPlan, ExtrapolatePlan, RecordPlan, RecordStart};
 use crate::{compare, extrapolation, record, report};
@@ -11,8 +12,11 @@ use recorder::format::{ExtrapolationReader, RecordingReader};
 pub const CASE_TOML: &str = include_str!("../cases/small_drum.toml");
 /// Periods extrapolated and simulated by the DEM for reference.
 pub const PERIODS: u32 = 6;
+/// DEM twins recorded: one second DEM run from t1 measures the DEM's own spread.
+pub const TWINS: u32 = 1;
 
 pub fn run(plan: &DemoPlan) -> Result<()> {
+    let began = std::time::Instant::now();
     let dir = &plan.output;
     recorder::output::create_dir_all(dir)?;
     let case_path = dir.join("small_drum.toml");
@@ -23,13 +27,14 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
     let report_dir = dir.join("report");
 
     println!(
-        "1/4 record    {}: {} particles, one revolution (τ = {} s), n = 10, Δt_c^max = 100 steps, \
-         then {PERIODS} periods of DEM as the reference",
+        "1/4 record    {}: {} particles, one revolution (τ = {} s), n = 10, Δt_c^max = 100 steps,\n\
+         \x20             then {PERIODS} periods of DEM as the reference and {TWINS} DEM twin from t1",
         case_path.display(),
         case.particles.count,
         case.drum.rotation_period
     );
-    let options = crate::cli::record_options(&case, None, None, 10, 100, PERIODS, false)?;
+    let mut options = crate::cli::record_options(&case, None, None, 10, 100, PERIODS, false)?;
+    options.twins = TWINS;
     record::run(RecordPlan {
         start: RecordStart::Fresh {
             case_path: case_path.clone(),
@@ -56,20 +61,25 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         json: false,
     })?;
 
-    println!("3/4 compare   against the DEM reference");
+    println!("3/4 compare   against the DEM reference and its twin");
     let rec = RecordingReader::open(&recording)?;
     let ext = ExtrapolationReader::open(&extra)?;
     let comparison = compare::compare(&rec, &ext, compare::DEFAULT_CELLS, compare::DEFAULT_SEED)?;
     print!("{}", compare::table(&comparison));
 
     println!("4/4 report");
-    let files = report::write(&report_dir, &rec, &ext, &comparison)?;
+    let files = report::write(&report_dir, &rec, &ext, Some(&comparison))?;
     for f in &files {
         println!("              {}", f.display());
     }
     println!(
         "done: open {} (or report.md beside it)",
         report_dir.join("report.html").display()
+    );
+    println!("verdict: the extrapolation {}", comparison.verdict.text);
+    println!(
+        "total time {:.0} s (record, extrapolate, compare and report)",
+        began.elapsed().as_secs_f64()
     );
     Ok(())
 }

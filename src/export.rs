@@ -1,5 +1,6 @@
 //! `tdex export vtk`: every snapshot of a recording or an extrapolation as a VTK PolyData
-//! file, and a `.pvd` series that ParaView opens in one click.
+//! file, and a `.pvd` series that ParaView opens in one click (a recording's DEM twins get a
+//! series each).
 
 use crate::cli::{ExportVtkPlan, UsageError};
 use anyhow::Result;
@@ -22,6 +23,7 @@ pub fn run(plan: &ExportVtkPlan) -> Result<()> {
 /// place only when every one is written (the series last): a failure leaves the previous
 /// series whole. Returns the files written.
 pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
+    let mut twins = Vec::new();
     let (snapshots, reference) = match open(&plan.file)? {
         Opened::Recording(r) => {
             if plan.reference.is_some() {
@@ -32,6 +34,7 @@ pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
                 ))
                 .into());
             }
+            twins = r.twin_snapshots()?;
             (r.snapshots()?, Vec::new())
         }
         Opened::Extrapolation(e) => {
@@ -80,6 +83,20 @@ pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
     }
     let pvd = format!("{stem}.pvd");
     set.add(&plan.output.join(pvd), vtk::collection(&series).as_bytes())?;
+    for (m, twin) in twins.iter().enumerate() {
+        let twin_stem = format!("{stem}_twin{}", m + 1);
+        let mut series = Vec::new();
+        for snap in twin {
+            let name = format!("{twin_stem}_{:04}.vtp", snap.index);
+            set.add(
+                &plan.output.join(&name),
+                vtk::polydata(snap, &[]).as_bytes(),
+            )?;
+            series.push((snap.time, name));
+        }
+        let pvd = format!("{twin_stem}.pvd");
+        set.add(&plan.output.join(pvd), vtk::collection(&series).as_bytes())?;
+    }
     Ok(set.commit()?)
 }
 

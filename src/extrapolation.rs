@@ -341,17 +341,17 @@ fn print(report: &ExtrapolationReport, json: bool) -> Result<()> {
     } else {
         let c = &report.costs;
         println!(
-            "extrapolation {} ({} periods, {} scheme, {} particles, {} rows, max CFL {:.4})",
+            "extrapolation {} ({} periods, {} scheme, {} particles, {} rows, max CFL {})",
             report.output,
             report.periods,
             report.scheme,
             report.particles,
             report.rows,
-            report.max_cfl
+            crate::fmt::sig(report.max_cfl, 4)
         );
         println!(
-            "pairing       mean distance {:.4} diameters, {} ({:.2} s{})",
-            report.pairing.mean_distance_diameters,
+            "pairing       mean distance {} diameters, {} ({:.2} s{})",
+            crate::fmt::sig(report.pairing.mean_distance_diameters, 4),
             if report.pairing.certified {
                 "certified"
             } else {

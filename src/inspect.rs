@@ -1,14 +1,22 @@
 //! `tdex inspect`: what a recording holds, read back from the file itself (the whole table is
-//! streamed, so a damaged file is reported here rather than during an extrapolation).
+//! streamed, so a damaged file is reported here rather than during an extrapolation), or
+//! what an extrapolation holds (its pairing, scheme and heat balance).
 
 use crate::cli::InspectPlan;
+use crate::fmt;
 use anyhow::Result;
 use extrapolate::replay::{self, Bodies, CflRow};
-use recorder::format::{RecordingCosts, RecordingReader};
+use extrapolate::sidecar::PairingSummary;
+use recorder::format::{
+    ExtrapolationCosts, ExtrapolationReader, FormatError, RecordingCosts, RecordingReader, Snapshot,
+};
 use serde::Serialize;
 
 /// Share of collisions that must last at least the suggested `n` steps (the paper's 97 %).
 const KEEP_FRACTION: f64 = 0.97;
+
+/// Histogram bins the human summary shows one by one; the rest are summed in one line.
+const SHOWN_BINS: usize = 24;
 
 #[derive(Debug, Serialize)]
 struct HistogramBin {
@@ -39,6 +47,8 @@ pub struct Sampling {
     pub period_steps: u64,
     pub t0: f64,
     pub reference_periods: u32,
+    /// DEM twins continued from `t1` over the reference periods.
+    pub twins: u32,
 }
 
 impl Sampling {
@@ -52,13 +62,77 @@ impl Sampling {
             period_steps: info.period_steps,
             t0: info.t0,
             reference_periods: info.reference_periods,
+            twins: info.twins,
         }
+    }
+
+    /// The `period` line of the human summaries: `τ`, its steps (`= N steps of Δt`, or
+    /// `(N steps of Δt)` when `bracketed`) and `t0`, then `then`.
+    pub fn print_period(&self, bracketed: bool, then: &str) {
+        let steps = format!("{} steps of {}", self.period_steps, fmt::seconds(self.dt));
+        let steps = if bracketed {
+            format!("({steps})")
+        } else {
+            format!("= {steps}")
+        };
+        println!(
+            "period        τ = {} {steps} from t0 = {}; {then}",
+            fmt::seconds(self.tau),
+            fmt::seconds(self.t0)
+        );
+    }
+
+    /// `n = 10, Δt_c^max = 100 steps`.
+    pub fn n_and_dtc_max(&self) -> String {
+        format!("n = {}, Δt_c^max = {} steps", self.n, self.dtc_max_steps)
     }
 }
 
-/// `tdex inspect --json` (keys documented in docs/user-guide.md).
+/// `value` as one pretty JSON object with `--json`, else as `human` writes it.
+pub fn emit<T: Serialize>(json: bool, value: &T, human: impl FnOnce(&T)) -> Result<()> {
+    if json {
+        println!("{}", serde_json::to_string_pretty(value)?);
+    } else {
+        human(value);
+    }
+    Ok(())
+}
+
+/// The first line of a human summary: what `file` is, its size and versions.
+fn print_file(kind: &str, file: &str, bytes: u64, format_version: u32, tool_version: &str) {
+    println!(
+        "{kind:<13} {file} ({:.1} MB, format {format_version}, tdex {tool_version})",
+        bytes as f64 / 1e6
+    );
+}
+
+/// The case's name as resolved into the recording ("" without one).
+fn case_name(info: &recorder::format::RecordingInfo) -> String {
+    info.case_resolved
+        .get("name")
+        .and_then(|v| v.as_str())
+        .unwrap_or("")
+        .into()
+}
+
+/// The walls held at a temperature.
+fn conducting_walls(info: &recorder::format::RecordingInfo) -> usize {
+    info.walls
+        .iter()
+        .filter(|w| w.temperature.is_some())
+        .count()
+}
+
+/// The mean particle temperature of `s` (K).
+fn mean_temperature(s: &Snapshot) -> f64 {
+    s.temp.iter().sum::<f64>() / s.len().max(1) as f64
+}
+
+/// `tdex inspect --json` on a recording (keys documented in docs/user-guide.md).
 #[derive(Debug, Serialize)]
 struct Inspection {
+    /// `recording`.
+    kind: &'static str,
     file: String,
     file_bytes: u64,
     format_version: u32,
@@ -77,14 +151,91 @@ struct Inspection {
     bytes_per_row: f64,
     collisions: u64,
     duration_histogram: Vec<HistogramBin>,
+    /// The largest `n` that [`KEEP_FRACTION`] of the collisions outlast and that divides the
+    /// recording's `period_steps` and `dtc_max_steps` (so `--n` accepts it as it is).
     suggested_n: Option<u64>,
+    /// The largest `n` that [`KEEP_FRACTION`] of the collisions outlast, whatever `τ` and
+    /// `Δt_c^max` allow.
+    suggested_n_unconstrained: Option<u64>,
     max_cfl: Option<CflRow>,
     snapshots: Vec<SnapshotSummary>,
     costs: Option<RecordingCosts>,
 }
 
+/// `tdex inspect --json` on an extrapolation (keys documented in docs/user-guide.md).
+#[derive(Debug, Serialize)]
+struct ExtrapolationInspection {
+    /// `extrapolation`.
+    kind: &'static str,
+    file: String,
+    file_bytes: u64,
+    format_version: u32,
+    tool_version: String,
+    /// The recording replayed (path as given when extrapolating).
+    recording: String,
+    case: String,
+    #[serde(flatten)]
+    sampling: Sampling,
+    walls: usize,
+    conducting_walls: usize,
+    scheme: String,
+    periods: u32,
+    /// The pairing's summary as stored (see `tdex pair --json`).
+    pairing: serde_json::Value,
+    /// Σ m c T (J) over the particles at the first snapshot (`t1`) and at the last, with
+    /// `m c = density · heat_capacity · (4/3)π r³` of the recording's material.
+    total_heat_start: f64,
+    total_heat_end: f64,
+    /// `(end − start) / start`.
+    heat_relative_change: f64,
+    /// Mean particle temperature (K) at the first and at the last snapshot.
+    mean_temperature_start: f64,
+    mean_temperature_end: f64,
+    /// Heat (J) the conducting walls gave the bed over the extrapolation (`end − start`);
+    /// `null` without conducting walls (the total is then conserved).
+    wall_heat: Option<f64>,
+    snapshots: Vec<ExtrapolatedSnapshot>,
+    costs: Option<ExtrapolationCosts>,
+}
+
+#[derive(Debug, Serialize)]
+struct ExtrapolatedSnapshot {
+    index: u32,
+    time: f64,
+    mean_temperature: f64,
+    total_heat: f64,
+}
+
+/// Summarises a recording, or an extrapolation (a file without recording metadata is
+/// read as one, the way `tdex compare` reads its second file).
 pub fn run(plan: &InspectPlan) -> Result<()> {
-    let reader = RecordingReader::open(&plan.file)?;
+    match RecordingReader::open(&plan.file) {
+        Ok(reader) => inspect_recording(plan, &reader),
+        Err(FormatError::NotRecording {
+            path,
+            detail: as_recording,
+            ..
+        }) => match ExtrapolationReader::open(&plan.file) {
+            Ok(reader) => inspect_extrapolation(plan, &reader),
+            Err(FormatError::NotRecording {
+                detail: as_extrapolation,
+                ..
+            }) => Err(FormatError::NotRecording {
+                path,
+                expected: "recording or extrapolation",
+                detail: format!(
+                    "{as_recording} (read as a recording); {as_extrapolation} (read as an \
+                     extrapolation)"
+                ),
+            }
+            .into()),
+            Err(e) => Err(e.into()),
+        },
+        Err(e) => Err(e.into()),
+    }
+}
+
+fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()> {
     let info = reader.info().clone();
     let snapshots = reader.snapshots()?;
     let t0 = snapshots.iter().find(|s| s.index == 0).ok_or_else(|| {
@@ -94,7 +245,7 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
         }
     })?;
     let (mut wall_rows, mut contact_steps) = (0u64, 0u64);
-    let found = replay::scan(&reader, &Bodies::of(&info, t0), |r, _| {
+    let found = replay::scan(reader, &Bodies::of(&info, t0), |r, _| {
         wall_rows += (r.j >= info.particles) as u64;
         contact_steps += r.duration_steps as u64;
     })?;
@@ -115,31 +266,25 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
     });
     let collisions: u64 = histogram.iter().map(|b| b.count).sum();
     // the largest n that KEEP_FRACTION of the collisions certainly outlast
-    let suggested_n = {
+    let suggested_n_unconstrained = {
         let mut shorter = 0u64;
         histogram.iter().find_map(|b| {
             shorter += b.count;
             (shorter as f64 > (1.0 - KEEP_FRACTION) * collisions as f64).then_some(b.min_steps)
         })
     };
+    let suggested_n = suggested_n_unconstrained
+        .map(|n| largest_divisor_up_to(gcd(info.period_steps, info.dtc_max_steps as u64), n));
     let inspection = Inspection {
+        kind: "recording",
         file: plan.file.display().to_string(),
         file_bytes: reader.file_bytes(),
         format_version: info.format_version,
         tool_version: info.tool_version.clone(),
-        case: info
-            .case_resolved
-            .get("name")
-            .and_then(|v| v.as_str())
-            .unwrap_or("")
-            .into(),
+        case: case_name(&info),
         sampling: Sampling::of(&info),
         walls: info.walls.len(),
-        conducting_walls: info
-            .walls
-            .iter()
-            .filter(|w| w.temperature.is_some())
-            .count(),
+        conducting_walls: conducting_walls(&info),
         area_encoding: format!("{:?}", info.area_encoding).to_lowercase(),
         rows: found.rows,
         wall_rows,
@@ -150,6 +295,7 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
         collisions,
         duration_histogram: histogram,
         suggested_n,
+        suggested_n_unconstrained,
         max_cfl: found.worst,
         snapshots: snapshots
             .iter()
@@ -164,40 +310,39 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
                 SnapshotSummary {
                     index: s.index,
                     time: s.time,
-                    mean_temperature: s.temp.iter().sum::<f64>() / n,
+                    mean_temperature: mean_temperature(s),
                     mean_position: mean,
                 }
             })
             .collect(),
         costs: reader.costs().cloned(),
     };
-    if plan.json {
-        println!("{}", serde_json::to_string_pretty(&inspection)?);
-    } else {
-        print_human(&inspection);
-    }
-    Ok(())
+    emit(plan.json, &inspection, print_human)
 }
 
 fn print_human(s: &Inspection) {
-    println!(
-        "recording     {} ({:.1} MB, format {}, tdex {})",
-        s.file,
-        s.file_bytes as f64 / 1e6,
+    print_file(
+        "recording",
+        &s.file,
+        s.file_bytes,
         s.format_version,
-        s.tool_version
+        &s.tool_version,
     );
     println!(
         "case          {}: {} particles, {} walls ({} conducting)",
         s.case, s.sampling.particles, s.walls, s.conducting_walls
     );
-    println!(
-        "period        τ = {} s = {} steps of {:e} s from t0 = {} s; {} reference periods",
-        s.sampling.tau,
-        s.sampling.period_steps,
-        s.sampling.dt,
-        s.sampling.t0,
-        s.sampling.reference_periods
+    s.sampling.print_period(
+        false,
+        &format!(
+            "{} reference periods{}",
+            s.sampling.reference_periods,
+            match s.sampling.twins {
+                0 => String::new(),
+                1 => ", 1 DEM twin from t1".to_string(),
+                m => format!(", {m} DEM twins from t1"),
+            }
+        ),
     );
     println!(
         "sampling      n = {} steps, Δt_c^max = {} steps, sqrt(a) {}",
@@ -213,23 +358,34 @@ fn print_human(s: &Inspection) {
     );
     let total = s.collisions.max(1) as f64;
     let mut cumulative = 0u64;
-    for b in &s.duration_histogram {
+    let (shown, tail) = s
+        .duration_histogram
+        .split_at(s.duration_histogram.len().min(SHOWN_BINS));
+    for b in shown {
         cumulative += b.count;
-        if b.samples <= 12 || b.count as f64 > 0.01 * total {
-            println!(
-                "  {:>4} samples ({:>5}–{:<5} steps) {:>10}  {:5.1} % ≤",
-                b.samples,
-                b.min_steps,
-                b.max_steps,
-                b.count,
-                100.0 * cumulative as f64 / total
-            );
-        }
+        println!(
+            "  {:>4} samples ({:>5}–{:<5} steps) {:>10}  {:5.1} % ≤",
+            b.samples,
+            b.min_steps,
+            b.max_steps,
+            b.count,
+            100.0 * cumulative as f64 / total
+        );
     }
-    match s.suggested_n {
-        Some(n) => println!("suggested n   {n} steps (97 % of the collisions last at least that)"),
-        None => println!("suggested n   - (no collisions)"),
+    if let (Some(first), Some(last)) = (tail.first(), tail.last()) {
+        let count: u64 = tail.iter().map(|b| b.count).sum();
+        println!(
+            "  {} more bins, {}–{} samples ({}–{} steps): {} collisions ({:.1} %), not shown one by one; --json has them all",
+            tail.len(),
+            first.samples,
+            last.samples,
+            first.min_steps,
+            last.max_steps,
+            count,
+            100.0 * count as f64 / total
+        );
     }
+    println!("suggested n   {}", suggested_n_line(s));
     if let Some(w) = &s.max_cfl {
         println!(
             "max CFL c     {:.4} (row {}: bodies {} and {}, m = {} steps, sqrt(a) = {:.4e} m){}",
@@ -248,9 +404,9 @@ fn print_human(s: &Inspection) {
     }
     for snap in &s.snapshots {
         println!(
-            "snapshot {:>3}  t = {:.4} s, mean T {:.6} K, mean position [{:.5}, {:.5}, {:.5}] m",
+            "snapshot {:>3}  t = {}, mean T {:.6} K, mean position [{:.5}, {:.5}, {:.5}] m",
             snap.index,
-            snap.time,
+            fmt::seconds(snap.time),
             snap.mean_temperature,
             snap.mean_position[0],
             snap.mean_position[1],
@@ -267,5 +423,203 @@ fn print_human(s: &Inspection) {
             "costs         {:.1} s to t0, {:.1} s period ({:.1} s recorder), {:.1} s reference; {} threads; stages {}",
             c.seconds_to_t0, c.seconds_period, c.seconds_recorder, c.seconds_reference, c.threads, stages.join(", ")
         );
+    }
+}
+
+/// The suggested `n` (it divides the recording's `τ` and `Δt_c^max` steps, so `--n` takes
+/// it with them), and when the 97 % share alone would allow a larger one, what to change
+/// for it: a second line, indented.
+fn suggested_n_line(s: &Inspection) -> String {
+    let (Some(n), Some(free)) = (s.suggested_n, s.suggested_n_unconstrained) else {
+        return "- (no collisions)".into();
+    };
+    let (period, dtc) = (s.sampling.period_steps, s.sampling.dtc_max_steps as u64);
+    let first = format!(
+        "{n} steps (divides τ = {period} and Δt_c^max = {dtc} steps; 97 % of the collisions \
+         last at least {free} steps)"
+    );
+    if n == free {
+        return first;
+    }
+    // the nearest multiple of m (at least m) to `steps`
+    let multiple = |steps: u64, m: u64| ((steps as f64 / m as f64).round() as u64).max(1) * m;
+    let mut options = Vec::new();
+    // τ is usually the one held: the largest n that divides it, with a Δt_c^max to match
+    let with_tau = largest_divisor_up_to(period, free);
+    if with_tau > n {
+        options.push(format!(
+            "n = {with_tau} with --dtc-max {}",
+            multiple(dtc, with_tau)
+        ));
+    }
+    if with_tau < free {
+        let mut changes = vec![format!(
+            "--tau {}",
+            // enough digits for `--tau` to give these steps back
+            fmt::sig(multiple(period, free) as f64 * s.sampling.dt, 12)
+        )];
+        if dtc % free != 0 {
+            changes.push(format!("--dtc-max {}", multiple(dtc, free)));
+        }
+        options.push(format!("n = {free} needs {}", changes.join(" and ")));
+    }
+    format!("{first}\n              or {}", options.join("; "))
+}
+
+/// Greatest common divisor (`gcd(a, 0) = a`).
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The largest divisor of `m` (≥ 1) that is at most `limit` (≥ 1); 1 if none is larger.
+fn largest_divisor_up_to(m: u64, limit: u64) -> u64 {
+    (1..=limit.min(m).max(1))
+        .rev()
+        .find(|d| m.is_multiple_of(*d))
+        .unwrap_or(1)
+}
+
+fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Result<()> {
+    let info = reader.info();
+    let ri = &info.recording_info;
+    let snapshots = reader.snapshots()?;
+    let (Some(first), Some(last)) = (snapshots.first(), snapshots.last()) else {
+        return Err(FormatError::Corrupt {
+            path: plan.file.clone(),
+            detail: "an extrapolation without snapshots (it holds t1 at least)".into(),
+        }
+        .into());
+    };
+    // each snapshot's own radii: point j is role j, with the radius of the particle there
+    let total_heat = |s: &Snapshot| replay::total_heat(&s.temp, &Bodies::of(ri, s));
+    let (start, end) = (total_heat(first), total_heat(last));
+    let conducting_walls = conducting_walls(ri);
+    let inspection = ExtrapolationInspection {
+        kind: "extrapolation",
+        file: plan.file.display().to_string(),
+        file_bytes: std::fs::metadata(&plan.file).map_or(0, |m| m.len()),
+        format_version: info.format_version,
+        tool_version: info.tool_version.clone(),
+        recording: info.recording.clone(),
+        case: case_name(ri),
+        sampling: Sampling::of(ri),
+        walls: ri.walls.len(),
+        conducting_walls,
+        scheme: info.scheme.clone(),
+        periods: info.periods,
+        pairing: info.pairing.clone(),
+        total_heat_start: start,
+        total_heat_end: end,
+        heat_relative_change: (end - start) / start,
+        mean_temperature_start: mean_temperature(first),
+        mean_temperature_end: mean_temperature(last),
+        wall_heat: (conducting_walls > 0).then_some(end - start),
+        snapshots: snapshots
+            .iter()
+            .map(|s| ExtrapolatedSnapshot {
+                index: s.index,
+                time: s.time,
+                mean_temperature: mean_temperature(s),
+                total_heat: total_heat(s),
+            })
+            .collect(),
+        costs: reader.costs().cloned(),
+    };
+    emit(plan.json, &inspection, print_extrapolation)
+}
+
+fn print_extrapolation(s: &ExtrapolationInspection) {
+    print_file(
+        "extrapolation",
+        &s.file,
+        s.file_bytes,
+        s.format_version,
+        &s.tool_version,
+    );
+    println!(
+        "recording     {}: case {}, {} particles, {} walls ({} conducting)",
+        s.recording, s.case, s.sampling.particles, s.walls, s.conducting_walls
+    );
+    s.sampling.print_period(false, &s.sampling.n_and_dtc_max());
+    let (first, last) = (s.snapshots.first(), s.snapshots.last());
+    let at = |snap: Option<&ExtrapolatedSnapshot>| {
+        snap.map_or("-".to_string(), |x| {
+            format!("t{} = {}", x.index, fmt::seconds(x.time))
+        })
+    };
+    println!(
+        "replay        {} periods, {} scheme: {} to {} ({} snapshots)",
+        s.periods,
+        s.scheme,
+        at(first),
+        at(last),
+        s.snapshots.len()
+    );
+    match serde_json::from_value::<PairingSummary>(s.pairing.clone()) {
+        Ok(p) => println!(
+            "pairing       {} particles, mean distance {} diameters (total {}), k = {}, {} solve round(s), {}",
+            p.particles,
+            fmt::num(p.mean_distance_diameters),
+            fmt::num(p.total_distance_diameters),
+            p.k_used,
+            p.rounds,
+            if p.certified {
+                "certified optimal"
+            } else {
+                "NOT certified"
+            }
+        ),
+        Err(_) => println!("pairing       {}", s.pairing),
+    }
+    println!(
+        "heat          Σ m c T {:.6e} J at the start, {:.6e} J at the end (relative change {:.2e})",
+        s.total_heat_start, s.total_heat_end, s.heat_relative_change
+    );
+    println!(
+        "mean T        {} at the start, {} at the end",
+        fmt::kelvin(s.mean_temperature_start),
+        fmt::kelvin(s.mean_temperature_end)
+    );
+    match s.wall_heat {
+        Some(q) => println!(
+            "walls         {} conducting wall{} gave {} J in total ({} J per period)",
+            s.conducting_walls,
+            if s.conducting_walls == 1 { "" } else { "s" },
+            fmt::num(q),
+            fmt::num(q / s.periods.max(1) as f64)
+        ),
+        None => println!("walls         adiabatic: the total heat is conserved"),
+    }
+    if let Some(c) = &s.costs {
+        println!(
+            "costs         pairing {} s{}, table read {} s, replay {} s per period ({:.3e} rows/s, {} rows)",
+            fmt::sig(c.seconds_pairing, 3),
+            if c.pairing_reused { " (reused)" } else { "" },
+            fmt::sig(c.seconds_read_table, 3),
+            fmt::sig(c.seconds_per_period, 3),
+            c.rows_per_second,
+            c.rows
+        );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_suggested_n_divides_the_period_and_dtc_max() {
+        assert_eq!(gcd(5000, 100), 100);
+        assert_eq!(gcd(7, 0), 7);
+        assert_eq!(largest_divisor_up_to(gcd(5000, 100), 11), 10);
+        assert_eq!(largest_divisor_up_to(gcd(5000, 100), 10), 10);
+        assert_eq!(largest_divisor_up_to(gcd(2500, 100), 7), 5);
+        assert_eq!(largest_divisor_up_to(gcd(2503, 100), 9), 1);
+        assert_eq!(largest_divisor_up_to(12, 100), 12);
+        assert_eq!(largest_divisor_up_to(1, 1), 1);
     }
 }

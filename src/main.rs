@@ -7,6 +7,7 @@ mod compare;
 mod demo;
 mod export;
 mod extrapolation;
+mod fmt;
 mod import;
 mod inspect;
 mod pair;

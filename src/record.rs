@@ -27,6 +27,8 @@ struct RecordReport {
     seconds_period: f64,
     seconds_recorder: f64,
     seconds_reference: f64,
+    /// The DEM twins' reference periods, all twins (0 without twins).
+    seconds_twins: f64,
     stage_seconds: BTreeMap<String, f64>,
 }
 
@@ -113,34 +115,54 @@ pub fn run(plan: RecordPlan) -> Result<()> {
         seconds_period: costs.seconds_period,
         seconds_recorder: costs.seconds_recorder,
         seconds_reference: costs.seconds_reference,
+        seconds_twins: costs.seconds_twins,
         stage_seconds: costs.stage_seconds.clone(),
     };
-    if plan.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
-    } else {
+    crate::inspect::emit(plan.json, &report, print_human)
+}
+
+fn print_human(report: &RecordReport) {
+    println!(
+        "recording     {} ({} particles, case {})",
+        report.output, report.sampling.particles, report.case
+    );
+    report
+        .sampling
+        .print_period(true, &report.sampling.n_and_dtc_max());
+    println!(
+        "table         {} rows ({} wall rows), {:.2} bytes per row, file {:.1} MB",
+        report.rows,
+        report.wall_rows,
+        report.bytes_per_row,
+        report.file_bytes as f64 / 1e6
+    );
+    let twins = report.sampling.twins;
+    if twins > 0 {
         println!(
-            "recording     {} ({} particles, case {})",
-            report.output, report.sampling.particles, report.case
+            "twins         {twins} DEM run{} continued from t1 over the {} reference periods, \
+             the drum's angular velocity changed by 1{} unit{} in the last place",
+            if twins == 1 { "" } else { "s" },
+            report.sampling.reference_periods,
+            if twins == 1 {
+                String::new()
+            } else {
+                format!("…{twins}")
+            },
+            if twins == 1 { "" } else { "s" },
         );
-        println!(
-            "period        τ = {} s ({} steps of {:e} s) from t0 = {} s; n = {}, Δt_c^max = {} steps",
-            report.sampling.tau, report.sampling.period_steps, report.sampling.dt, report.sampling.t0, report.sampling.n, report.sampling.dtc_max_steps
-        );
-        println!(
-            "table         {} rows ({} wall rows), {:.2} bytes per row, file {:.1} MB",
-            report.rows,
-            report.wall_rows,
-            report.bytes_per_row,
-            report.file_bytes as f64 / 1e6
-        );
-        if report.costs_recorded {
-            println!(
-                "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
-                report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
-            );
-        } else {
-            println!("time          not recorded (--reproducible)");
-        }
     }
-    Ok(())
+    if report.costs_recorded {
+        println!(
+            "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
+            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
+        );
+        if twins > 0 {
+            println!(
+                "              {:.1} s for the twins' reference periods",
+                report.seconds_twins
+            );
+        }
+    } else {
+        println!("time          not recorded (--reproducible)");
+    }
 }

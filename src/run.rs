@@ -115,7 +115,7 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
 }
 
 fn opt(v: Option<f64>) -> String {
-    v.map_or("-".into(), |x| format!("{x:.4}"))
+    v.map_or("-".into(), crate::fmt::num)
 }
 
 fn print_human(s: &RunSummary) {
@@ -125,8 +125,11 @@ fn print_human(s: &RunSummary) {
         s.case, s.case_file, s.particles, s.threads
     );
     println!(
-        "steps         settle {} + spin-up {} + heating {} (dt {:e} s)",
-        s.steps_settle, s.steps_spin_up, s.steps_heating, s.dt
+        "steps         settle {} + spin-up {} + heating {} (dt {})",
+        s.steps_settle,
+        s.steps_spin_up,
+        s.steps_heating,
+        crate::fmt::seconds(s.dt)
     );
     println!(
         "speed         {:.1} s wall, {:.3e} particle-steps/s ({:.3e} while heating), {} neighbour rebuilds",

@@ -114,6 +114,23 @@ fn kill_when(
     }
 }
 
+/// Resumes the run of checkpoint `ck_arg` to its end and asserts that the recording `b` it
+/// writes is `a`, the uninterrupted run's, byte for byte (`stops`: where it was killed).
+fn resume_to_the_end(ck_arg: &str, a: &Path, b: &Path, stops: &[String]) {
+    let o = run_tdex(&["record", "--resume", ck_arg]);
+    assert!(
+        o.status.success(),
+        "stops: {stops:#?}\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let (a_bytes, b_bytes) = (std::fs::read(a).unwrap(), std::fs::read(b).unwrap());
+    assert_eq!(a_bytes.len(), b_bytes.len(), "stops: {stops:#?}");
+    assert!(
+        a_bytes == b_bytes,
+        "the resumed recording differs; stops: {stops:#?}"
+    );
+}
+
 #[test]
 fn a_recording_killed_in_every_stage_resumes_to_the_same_bytes() {
     let dir = tempfile::tempdir().unwrap();
@@ -141,18 +158,7 @@ fn a_recording_killed_in_every_stage_resumes_to_the_same_bytes() {
         stops.push(kill_at(resumed, &ck, stage));
     }
     assert!(!b.exists(), "a killed run left {}", b.display());
-    let o = run_tdex(&["record", "--resume", &ck_arg]);
-    assert!(
-        o.status.success(),
-        "stops: {stops:#?}\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let (a_bytes, b_bytes) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
-    assert_eq!(a_bytes.len(), b_bytes.len(), "stops: {stops:#?}");
-    assert!(
-        a_bytes == b_bytes,
-        "the resumed recording differs; stops: {stops:#?}"
-    );
+    resume_to_the_end(&ck_arg, &a, &b, &stops);
     // the checkpoint, its journal and the killed runs' partial files are gone
     assert_eq!(file_names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
 }
@@ -296,8 +302,8 @@ fn checkpoints_with_a_valid_crc_but_altered_state_never_panic() {
         let outcome = std::panic::catch_unwind(|| -> Result<(), String> {
             let c = Checkpoint::read(&altered).map_err(|e| e.to_string())?;
             let case = c.case(&altered).map_err(|e| e.to_string())?;
-            let (mut sim, stage, _, output) =
-                c.restore(&case, &altered).map_err(|e| e.to_string())?;
+            let restored = c.restore(&case, &altered).map_err(|e| e.to_string())?;
+            let (mut sim, stage, output) = (restored.sim, restored.stage, restored.output);
             for _ in 0..20 {
                 sim.step();
             }
@@ -325,4 +331,45 @@ fn checkpoints_with_a_valid_crc_but_altered_state_never_panic() {
         "altered checkpoints: {refused} refused, {resumed} accepted (values changed within range)"
     );
     assert!(refused > 0);
+}
+
+#[test]
+fn a_recording_with_twins_killed_in_its_reference_and_twin_stages_resumes_to_the_same_bytes() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let twins = ["--twins", "2", "--reproducible", "--threads", "2"];
+    let o = run_tdex(&record_args(&case, &a, &twins));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let ck = checkpoint_of(&b);
+    let ck_arg = ck.to_str().unwrap().to_string();
+    let mut args = record_args(&case, &b, &twins);
+    args.extend(["--checkpoint-every", "0.02"]);
+    // the header names the stage after the case: ", reference period 2 of 2 step" is the
+    // run's own, ", twin 1 of 2 reference period ..." a twin's
+    let mut stops = vec![kill_at(spawn(&args), &ck, ", reference period 2 of 2")];
+    for stage in [
+        ", twin 1 of 2 reference period 2",
+        ", twin 2 of 2 reference period 1",
+    ] {
+        assert!(!b.exists(), "a killed run left {}", b.display());
+        let resumed = spawn(&["record", "--resume", &ck_arg, "--threads", "1"]);
+        stops.push(kill_at(resumed, &ck, stage));
+    }
+    resume_to_the_end(&ck_arg, &a, &b, &stops);
+    // both twins are stored, differ from the DEM and from each other
+    let rec = recorder::format::RecordingReader::open(&a).unwrap();
+    let twins = rec.twin_snapshots().unwrap();
+    let dem = rec.snapshots().unwrap();
+    assert_eq!(twins.len(), 2);
+    for (m, twin) in twins.iter().enumerate() {
+        assert_eq!(twin.iter().map(|s| s.index).collect::<Vec<_>>(), [2, 3]);
+        assert_ne!(twin[0].pos, dem[2].pos, "twin {} is the DEM", m + 1);
+    }
+    assert_ne!(
+        twins[0][0].pos, twins[1][0].pos,
+        "the two twins are one run"
+    );
+    assert_eq!(file_names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
 }

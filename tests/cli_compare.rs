@@ -244,3 +244,156 @@ fn a_second_dem_run_is_compared_on_its_own_particles() {
         "{err}"
     );
 }
+
+/// A recording with one real DEM twin: `compare` measures the floor between the DEM and
+/// the twin at every t_k, the extrapolation's distance to both runs and the ratio, and says
+/// its verdict; the twin is stored in the recording, found without extra arguments.
+#[test]
+fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("case.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    let (run, extra) = (dir.path().join("run.mcap"), dir.path().join("extra.mcap"));
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        run_s,
+        "--tau-rev",
+        "0.25",
+        "--reference",
+        "3",
+        "--twins",
+        "1",
+    ]);
+    tdex_ok(&["extrapolate", run_s, "--periods", "3", "-o", extra_s]);
+    let twins = RecordingReader::open(&run)
+        .unwrap()
+        .twin_snapshots()
+        .unwrap();
+    assert_eq!(twins.len(), 1);
+
+    let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["dem_runs"], 2);
+    let periods = v["periods"].as_array().unwrap();
+    assert_eq!(periods.len(), 3, "t2, t3 and t4");
+    let mut ratios = Vec::new();
+    for p in periods {
+        let num = |key: &str| {
+            p[key]
+                .as_f64()
+                .unwrap_or_else(|| panic!("{key} missing at k = {}: {p}", p["k"]))
+        };
+        let (floor, max, min) = (
+            num("floor_eps_abs"),
+            num("floor_eps_abs_max"),
+            num("floor_eps_abs_min"),
+        );
+        // one pair of runs: mean, smallest and largest floor are that pair's distance
+        assert!(floor > 0.0, "the twin differs from the DEM: {p}");
+        assert_eq!((floor, floor), (max, min));
+        assert!((num("floor_eps_rel") - floor / num("contrast")).abs() < 1e-12);
+        // the distance to the runs is the mean of the distance to the DEM (eps_abs) and to
+        // the twin: it cannot be below half the DEM distance
+        let to_runs = num("eps_abs_to_dem_runs");
+        assert!(to_runs >= 0.5 * num("eps_abs") - 1e-12, "{p}");
+        assert!((num("ratio_to_floor") - to_runs / floor).abs() < 1e-9 * to_runs / floor);
+        assert_eq!(p["dem_runs_hot_mean"].as_array().unwrap().len(), 1);
+        ratios.push(num("ratio_to_floor"));
+    }
+    let verdict = &v["verdict"];
+    ratios.sort_by(f64::total_cmp);
+    let median = ratios[1];
+    assert!((verdict["median_ratio"].as_f64().unwrap() - median).abs() < 1e-12);
+    assert_eq!(verdict["passes"].as_bool().unwrap(), {
+        let inside = periods.iter().all(|p| {
+            p["eps_abs_to_dem_runs"].as_f64().unwrap() <= p["floor_eps_abs_max"].as_f64().unwrap()
+        });
+        inside && median <= 1.0
+    });
+    let text = tdex_ok(&["compare", run_s, extra_s, "--cells", "20"]);
+    assert!(
+        text.lines()
+            .last()
+            .unwrap()
+            .starts_with(&format!("verdict: {}", verdict["text"].as_str().unwrap())),
+        "{text}"
+    );
+    assert!(text.contains("floor max"), "{text}");
+
+    // export vtk writes the twin's own series beside the DEM's
+    let vtk = dir.path().join("vtk");
+    tdex_ok(&["export", "vtk", run_s, "-o", vtk.to_str().unwrap()]);
+    let names = file_names(&vtk);
+    for name in [
+        "run.pvd",
+        "run_twin1.pvd",
+        "run_twin1_0002.vtp",
+        "run_twin1_0004.vtp",
+    ] {
+        assert!(names.iter().any(|n| n == name), "{name} not in {names:?}");
+    }
+    assert!(
+        !names.iter().any(|n| n == "run_twin1_0001.vtp"),
+        "{names:?}"
+    );
+
+    // the arguments the wrong way round are named as such
+    let o = run_tdex(&["compare", extra_s, run_s]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("the recording comes first"), "{err}");
+}
+
+/// `tdex pair --json` states the cycle structure of `g`, which the test counts again from the
+/// stored pairing.
+#[test]
+fn pair_reports_the_cycle_structure_of_the_pairing() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, _) = record_and_extrapolate(dir.path(), 0, 1);
+    let run_s = run.to_str().unwrap();
+    let v: serde_json::Value = serde_json::from_str(&tdex_ok(&["pair", run_s, "--json"])).unwrap();
+    let stored: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(v["pairing_file"].as_str().unwrap()).unwrap())
+            .unwrap();
+    let g: Vec<usize> = stored["g"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_u64().unwrap() as usize)
+        .collect();
+    let mut lengths = Vec::new();
+    let mut seen = vec![false; g.len()];
+    for start in 0..g.len() {
+        let (mut p, mut len) = (start, 0);
+        while !seen[p] {
+            seen[p] = true;
+            p = g[p];
+            len += 1;
+        }
+        if len > 0 {
+            lengths.push(len);
+        }
+    }
+    let c = &v["cycles"];
+    assert_eq!(c["cycles"], lengths.len());
+    assert_eq!(
+        c["fixed_points"],
+        lengths.iter().filter(|&&l| l == 1).count()
+    );
+    let short: usize = lengths.iter().filter(|&&l| l <= 10).sum();
+    assert_eq!(c["on_short_cycles"], short);
+    assert_eq!(c["longest"], *lengths.iter().max().unwrap());
+    assert_eq!(
+        c["short_share"].as_f64().unwrap(),
+        short as f64 / g.len() as f64
+    );
+    let text = tdex_ok(&["pair", run_s]);
+    assert!(
+        text.contains(&format!("{} fixed points", c["fixed_points"])),
+        "{text}"
+    );
+}

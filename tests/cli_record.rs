@@ -41,6 +41,26 @@ fn record(case: &Path, out: &Path, extra: &[&str]) {
     );
 }
 
+/// Writes a valid MCAP file of another tool to `path`: one JSON message on `/camera`.
+pub(crate) fn write_foreign_mcap(path: &Path) {
+    let file = std::io::BufWriter::new(std::fs::File::create(path).unwrap());
+    let mut w = mcap::Writer::new(file).unwrap();
+    let ch = w
+        .add_channel(0, "/camera", "json", &Default::default())
+        .unwrap();
+    w.write_to_known_channel(
+        &mcap::records::MessageHeader {
+            channel_id: ch,
+            sequence: 0,
+            log_time: 0,
+            publish_time: 0,
+        },
+        b"{}",
+    )
+    .unwrap();
+    w.finish().unwrap();
+}
+
 fn inspect_json(file: &Path) -> serde_json::Value {
     let o = run_tdex(&["inspect", file.to_str().unwrap(), "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -231,24 +251,7 @@ fn damaged_foreign_and_missing_files_are_refused_with_clear_errors() {
 
     // a valid MCAP file of another tool
     let foreign = dir.path().join("foreign.mcap");
-    {
-        let file = std::io::BufWriter::new(std::fs::File::create(&foreign).unwrap());
-        let mut w = mcap::Writer::new(file).unwrap();
-        let ch = w
-            .add_channel(0, "/camera", "json", &Default::default())
-            .unwrap();
-        w.write_to_known_channel(
-            &mcap::records::MessageHeader {
-                channel_id: ch,
-                sequence: 0,
-                log_time: 0,
-                publish_time: 0,
-            },
-            b"{}",
-        )
-        .unwrap();
-        w.finish().unwrap();
-    }
+    write_foreign_mcap(&foreign);
     assert_refused(&foreign, "not a tdex recording");
 }
 

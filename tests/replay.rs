@@ -1,4 +1,4 @@
-//! The replay against the DEM (DESIGN.md §6): self-consistency with `n = 1`,
+//! The replay against the DEM (docs/method.md §6): self-consistency with `n = 1`,
 //! `Δt_c^max = 1` step and the synchronous scheme; heat conservation of every scheme over
 //! 100 periods; the explicit scheme's CFL refusal through the CLI.
 

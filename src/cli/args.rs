@@ -38,6 +38,12 @@ pub enum Command {
         /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
         #[arg(long, default_value_t = 0)]
         reference: u32,
+        /// Also continue M more DEM runs ("twins") from the state at t1 over the same K
+        /// reference periods, twin m with the drum's angular velocity changed by m units in
+        /// its last place: the DEM's own run-to-run spread, against which `compare` and
+        /// `report` judge the extrapolation. Each twin costs the reference periods again.
+        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16), requires = "reference")]
+        twins: u32,
         /// Worker threads (default: all cores). The recording does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
@@ -55,7 +61,7 @@ pub enum Command {
         #[arg(
             long,
             value_name = "CHECKPOINT",
-            conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "reproducible"]
+            conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "reproducible"]
         )]
         resume: Option<PathBuf>,
         /// Leave out the costs record (wall times, thread count): the same case, seed and
@@ -127,6 +133,11 @@ pub enum Command {
         /// Print one CSV line per t_k on stdout.
         #[arg(long)]
         csv: bool,
+        /// A further DEM run of the same case over the same t_k (a recording: another
+        /// engine's run imported, a perturbed case), added to the recording's own twins to
+        /// measure the DEM's run-to-run spread. Repeatable.
+        #[arg(long = "dem-run", value_name = "RECORDING")]
+        dem_runs: Vec<PathBuf>,
     },
     /// Write a self-contained report (report.md, report.html, SVG plots) of an extrapolation
     /// against its recording: the error table, the cost table for 100 periods, plots.
@@ -138,6 +149,10 @@ pub enum Command {
         /// The report directory (created if missing; files in it are replaced).
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
+        /// A further DEM run of the same case over the same t_k, added to the recording's
+        /// own twins to measure the DEM's run-to-run spread (as `compare --dem-run`).
+        #[arg(long = "dem-run", value_name = "RECORDING")]
+        dem_runs: Vec<PathBuf>,
         /// Voronoi cells (seeds drawn inside the bed).
         #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
         cells: usize,
@@ -170,9 +185,10 @@ pub enum Command {
     #[command(subcommand)]
     Study(StudyCommand),
     /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
-    /// suggested n, costs. Reads the whole table, so it also checks the file.
+    /// suggested n, costs. Reads the whole table, so it also checks the file. Given an
+    /// extrapolation: its recording, periods, scheme, pairing and heat balance.
     Inspect {
-        /// The recording (MCAP).
+        /// The recording or extrapolation (MCAP).
         file: PathBuf,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]

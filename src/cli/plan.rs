@@ -108,6 +108,8 @@ pub struct ReportPlan {
     pub recording: PathBuf,
     pub extrapolation: PathBuf,
     pub output: PathBuf,
+    /// Further DEM runs of the case for the floor (`--dem-run`).
+    pub dem_runs: Vec<PathBuf>,
     pub cells: usize,
     pub seed: u64,
 }
@@ -115,6 +117,8 @@ pub struct ReportPlan {
 pub struct ComparePlan {
     pub recording: PathBuf,
     pub extrapolation: PathBuf,
+    /// Further DEM runs of the case for the floor (`--dem-run`).
+    pub dem_runs: Vec<PathBuf>,
     pub cells: usize,
     pub seed: u64,
     pub json: bool,
@@ -230,6 +234,7 @@ impl Plan {
                 case,
                 table,
                 reference,
+                twins,
                 threads: t,
                 json,
                 checkpoint_every,
@@ -255,7 +260,14 @@ impl Plan {
                     }
                     (None, Some(case)) => {
                         let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                        let (options, output) = table_options(&loaded, &table, reference)?;
+                        let (mut options, output) = table_options(&loaded, &table, reference)?;
+                        if twins > 0 && reference == 0 {
+                            return Err(usage(format!(
+                                "--twins {twins} needs --reference K: the twins run over the \
+                                 reference periods"
+                            )));
+                        }
+                        options.twins = twins;
                         RecordStart::Fresh {
                             case_path: case,
                             case_toml,
@@ -329,11 +341,13 @@ impl Plan {
                 seed,
                 json,
                 csv,
+                dem_runs,
             } => {
                 check_cells(cells)?;
                 Ok(Plan::Compare(ComparePlan {
                     recording,
                     extrapolation,
+                    dem_runs,
                     cells,
                     seed,
                     json,
@@ -344,6 +358,7 @@ impl Plan {
                 recording,
                 extrapolation,
                 output,
+                dem_runs,
                 cells,
                 seed,
             } => {
@@ -353,6 +368,7 @@ impl Plan {
                     recording,
                     extrapolation,
                     output,
+                    dem_runs,
                     cells,
                     seed,
                 }))
@@ -528,8 +544,11 @@ pub(crate) fn record_options(
     {
         let valid = (exact_steps / n as f64).round().max(1.0) * n as f64 * case.time.dt;
         return Err(usage(format!(
-            "τ = {tau_seconds} s is {exact_steps} DEM steps of {} s: it must be a whole multiple of n = {n} steps (nearest allowed τ = {valid} s)",
-            case.time.dt
+            "τ = {} s is {} DEM steps of {}: it must be a whole multiple of n = {n} steps (nearest allowed τ = {} s)",
+            crate::fmt::sig(tau_seconds, 12),
+            crate::fmt::sig(exact_steps, 9),
+            crate::fmt::seconds(case.time.dt),
+            crate::fmt::sig(valid, 12)
         )));
     }
     Ok(RecordOptions {
@@ -537,6 +556,7 @@ pub(crate) fn record_options(
         dtc_max_steps: dtc_max,
         period_steps,
         reference_periods: reference,
+        twins: 0,
         area_encoding: if exact_area {
             AreaEncoding::Exact
         } else {
@@ -784,7 +804,8 @@ fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
                 let periods = k.round();
                 if periods < 1.0 || (k - periods).abs() > 1e-9 * k {
                     return Err(usage(format!(
-                        "--tau-rev {f} with --revolutions {revolutions}: {revolutions} revolutions are {k} periods of {f} revolution; they must be a whole number ≥ 1"
+                        "--tau-rev {f} with --revolutions {revolutions}: {revolutions} revolutions are {} periods of {f} revolution; they must be a whole number ≥ 1",
+                        crate::fmt::sig(k, 9)
                     )));
                 }
                 runs.push((

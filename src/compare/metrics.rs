@@ -140,6 +140,18 @@ pub fn group_mean(temps: &[f64], group: &[u32]) -> f64 {
     group.iter().map(|&p| temps[p as usize]).sum::<f64>() / group.len() as f64
 }
 
+/// The bed's mean temperature weighted by particle volume (`r³`): with one material, the
+/// mean of the heat content, which only the walls change.
+pub fn bed_mean(radius: &[f64], temps: &[f64]) -> f64 {
+    let (heat, volume) = radius
+        .iter()
+        .zip(temps)
+        .fold((0.0, 0.0), |(h, v), (&r, &t)| {
+            (h + r * r * r * t, v + r * r * r)
+        });
+    heat / volume
+}
+
 /// Temperatures indexed by particle id from a snapshot whose point `j` is particle `id[j]`.
 pub fn by_id(id: &[u32], temps: &[f64]) -> Vec<f64> {
     let mut out = vec![0.0; temps.len()];

@@ -1,15 +1,19 @@
-//! `tdex compare`: the extrapolation against the DEM reference at every `t_k` (DESIGN.md
+//! `tdex compare`: the extrapolation against the DEM reference at every `t_k` (docs/method.md
 //! §7): Voronoi-cell errors, the Eq. 10 energy-transfer error, hot/cold group means. The
 //! same measures between two DEM runs of one case give the floor no extrapolation can beat.
 
+pub mod floor;
 pub mod metrics;
+pub mod verdict;
 
 use crate::cli::ComparePlan;
 use crate::cli::UsageError;
 use anyhow::{Context, Result};
+use floor::{Field, Floor};
 use metrics::Cells;
 use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 use serde::Serialize;
+pub use verdict::Verdict;
 
 /// Default number of Voronoi cells (the paper's v = 200).
 pub const DEFAULT_CELLS: usize = 200;
@@ -52,11 +56,20 @@ pub struct Comparison {
     /// Sizes of the initially hot and cold groups (0 if the bed started uniform).
     pub hot_particles: usize,
     pub cold_particles: usize,
+    /// DEM runs that measure the floor: the reference, its twins and any further runs given
+    /// (1: no floor).
+    pub dem_runs: usize,
+    /// What `eps_rel` divides by.
+    pub contrast: ContrastKind,
     /// One entry per extrapolated `t_k` that has a DEM reference (k ≥ 2; k ≥ 1 against a
     /// second DEM run).
     pub periods: Vec<PeriodComparison>,
     /// Group means of every DEM snapshot (k = 0, 1, then the reference), for plots.
     pub dem_series: Vec<GroupMeans>,
+    /// The same for each further DEM run (twins first), at their own reference `t_k`.
+    pub dem_runs_series: Vec<Vec<GroupMeans>>,
+    /// How far to trust the extrapolation, from the numbers above.
+    pub verdict: Verdict,
     /// Extrapolated `t_k` without a DEM reference (recorded with a smaller `--reference`).
     pub unreferenced: Vec<u32>,
 }
@@ -78,6 +91,53 @@ pub struct PeriodComparison {
     pub hot_mean_extra: Option<f64>,
     pub cold_mean_dem: Option<f64>,
     pub cold_mean_extra: Option<f64>,
+    /// Bed means (K, weighted by particle volume: the heat-content mean).
+    pub bed_mean_dem: f64,
+    pub bed_mean_extra: f64,
+    /// What `eps_rel` divides by at this `t_k` (K): `|T̄_hot − T̄_cold|` of the DEM, or for a
+    /// bed without groups `|T_wall − T̄_bed|` of the DEM; null when neither exists.
+    pub contrast: Option<f64>,
+    /// The DEM's own spread (null with a single DEM run): the mean, smallest and largest
+    /// `ε_abs` between two DEM runs, the mean relative to `contrast`, the second field's mean
+    /// `ε_abs` to the DEM runs and its ratio to the mean floor (null when the floor is 0).
+    pub floor_eps_abs: Option<f64>,
+    pub floor_eps_abs_min: Option<f64>,
+    pub floor_eps_abs_max: Option<f64>,
+    pub floor_eps_rel: Option<f64>,
+    pub eps_abs_to_dem_runs: Option<f64>,
+    pub ratio_to_floor: Option<f64>,
+    /// Eq. 10 of each further DEM run against the reference, the largest in magnitude.
+    pub floor_energy_error: Option<f64>,
+    /// Group and bed means of the further DEM runs at this `t_k` (twins first).
+    pub dem_runs_hot_mean: Vec<f64>,
+    pub dem_runs_cold_mean: Vec<f64>,
+    pub dem_runs_bed_mean: Vec<f64>,
+}
+
+impl PeriodComparison {
+    /// The floor at this `t_k`, if measured.
+    pub fn floor(&self) -> Option<Floor> {
+        Some(Floor {
+            floor_eps_abs: self.floor_eps_abs?,
+            floor_eps_abs_min: self.floor_eps_abs_min?,
+            floor_eps_abs_max: self.floor_eps_abs_max?,
+            floor_pairs: 0,
+            eps_abs_to_dem_runs: self.eps_abs_to_dem_runs?,
+            ratio_to_floor: self.ratio_to_floor,
+        })
+    }
+}
+
+/// What `eps_rel` is relative to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContrastKind {
+    /// The DEM's hot-group mean minus its cold-group mean (split beds; the paper's).
+    HotCold,
+    /// The conducting wall's temperature minus the DEM's bed mean (uniform beds, heated wall).
+    WallBed,
+    /// Neither: `eps_rel` is absent.
+    None,
 }
 
 /// Mean temperatures of the hot and cold groups in one snapshot.
@@ -87,7 +147,12 @@ pub struct GroupMeans {
     pub t: f64,
     pub hot: Option<f64>,
     pub cold: Option<f64>,
+    /// Volume-weighted bed mean (K).
+    pub bed: f64,
 }
+
+/// The initially hot and cold particles of a run (`None`: a uniform start).
+type HotCold = Option<(Vec<u32>, Vec<u32>)>;
 
 /// The inputs cannot be compared (exit code 2, like any bad input).
 macro_rules! refuse {
@@ -97,14 +162,41 @@ macro_rules! refuse {
 }
 
 pub fn run(plan: &ComparePlan) -> Result<()> {
-    let recording = RecordingReader::open(&plan.recording)?;
+    let recording = match RecordingReader::open(&plan.recording) {
+        Ok(r) => r,
+        // an extrapolation given first: the arguments are the wrong way round
+        Err(FormatError::NotRecording { .. })
+            if ExtrapolationReader::open(&plan.recording).is_ok() =>
+        {
+            refuse!(
+                "{} is not a tdex recording but an extrapolation: the arguments are the \
+                 wrong way round, the recording comes first (tdex compare RUN.mcap EXTRA.mcap)",
+                plan.recording.display()
+            );
+        }
+        Err(e) => return Err(e.into()),
+    };
     // A file without recording metadata is read as an extrapolation, whose reader then
     // names what is missing; any other fault of a recording is reported as it is.
+    let dem_runs = open_dem_runs(&plan.dem_runs)?;
+    let dem_runs: Vec<&RecordingReader> = dem_runs.iter().collect();
     let c = match RecordingReader::open(&plan.extrapolation) {
-        Ok(dem) => compare_with(&recording, Second::Dem(&dem), plan.cells, plan.seed)?,
+        Ok(dem) => compare_runs(
+            &recording,
+            Second::Dem(&dem),
+            &dem_runs,
+            plan.cells,
+            plan.seed,
+        )?,
         Err(FormatError::NotRecording { .. }) => {
             let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
-            compare(&recording, &extrapolation, plan.cells, plan.seed)?
+            compare_runs(
+                &recording,
+                Second::Extrapolation(&extrapolation),
+                &dem_runs,
+                plan.cells,
+                plan.seed,
+            )?
         }
         Err(e) => return Err(e.into()),
     };
@@ -116,6 +208,14 @@ pub fn run(plan: &ComparePlan) -> Result<()> {
         print!("{}", table(&c));
     }
     Ok(())
+}
+
+/// The further DEM runs given with `--dem-run`, opened as recordings.
+pub fn open_dem_runs(paths: &[std::path::PathBuf]) -> Result<Vec<RecordingReader>> {
+    Ok(paths
+        .iter()
+        .map(|p| RecordingReader::open(p))
+        .collect::<Result<Vec<_>, _>>()?)
 }
 
 /// Compares `extrapolation` with the DEM reference snapshots of `recording`.
@@ -135,8 +235,27 @@ pub fn compare_with(
     cells: usize,
     seed: u64,
 ) -> Result<Comparison> {
+    compare_runs(recording, second, &[], cells, seed)
+}
+
+/// Compares the `second` field with the DEM reference snapshots of `recording`, and measures
+/// the DEM's own spread between the reference, the recording's twins and `dem_runs`
+/// (further recordings of the same case over the same `t_k`).
+pub fn compare_runs(
+    recording: &RecordingReader,
+    second: Second,
+    dem_runs: &[&RecordingReader],
+    cells: usize,
+    seed: u64,
+) -> Result<Comparison> {
     let rec_path = recording.path().display().to_string();
     let dem = recording.snapshots()?;
+    let mut others = recording.twin_snapshots()?;
+    for run in dem_runs {
+        let snaps = run.snapshots()?;
+        check_same_instants((recording, &dem), (run, &snaps))?;
+        others.push(snaps);
+    }
     let (extra_path, extra, kind) = match second {
         Second::Extrapolation(extrapolation) => {
             let extra_path = extrapolation.path().display().to_string();
@@ -195,19 +314,42 @@ pub fn compare_with(
     };
     let means = |temps_by_id: &[f64]| means_in(&groups, temps_by_id);
     let by_id = |s: &Snapshot| metrics::by_id(&s.id, &s.temp);
-
-    let dem_series = dem
+    // a further run that starts at t0 has its own hot and cold particles (the same rule at
+    // its own t0); a twin starts at t1 from the reference's state and shares its groups
+    let run_groups: Vec<HotCold> = others
         .iter()
-        .map(|s| {
-            let (hot, cold) = means(&s.temp);
-            GroupMeans {
-                k: s.index,
-                t: s.time,
-                hot,
-                cold,
-            }
+        .map(|o| match o.iter().find(|s| s.index == 0) {
+            Some(t0) => metrics::hot_cold_groups(&t0.temp),
+            None => groups.clone(),
         })
         .collect();
+    let series = |snaps: &[Snapshot], groups: &HotCold| -> Vec<GroupMeans> {
+        snaps
+            .iter()
+            .map(|s| {
+                let (hot, cold) = means_in(groups, &s.temp);
+                GroupMeans {
+                    k: s.index,
+                    t: s.time,
+                    hot,
+                    cold,
+                    bed: metrics::bed_mean(&s.radius, &s.temp),
+                }
+            })
+            .collect()
+    };
+    let dem_series = series(&dem, &groups);
+    let dem_runs_series: Vec<Vec<GroupMeans>> = others
+        .iter()
+        .zip(&run_groups)
+        .map(|(o, g)| series(o, g))
+        .collect();
+    let wall_temperature = recording.info().walls.iter().find_map(|w| w.temperature);
+    let contrast_kind = match (&groups, wall_temperature) {
+        (Some(_), _) => ContrastKind::HotCold,
+        (None, Some(_)) => ContrastKind::WallBed,
+        (None, None) => ContrastKind::None,
+    };
 
     // The extrapolated positions are the roles' positions at t1: one cell assignment; a
     // second DEM run moves, so each of its snapshots is assigned anew.
@@ -238,13 +380,51 @@ pub fn compare_with(
         let (hot_dem, cold_dem) = means(&dem_after.temp);
         let extra_after = by_id(after);
         let (hot_extra, cold_extra) = means_in(&extra_groups, &extra_after);
-        let scale = hot_dem.zip(cold_dem).map(|(h, c)| (h - c).abs());
+        let bed_mean_dem = metrics::bed_mean(&dem_after.radius, &dem_after.temp);
+        let scale = match contrast_kind {
+            ContrastKind::HotCold => hot_dem.zip(cold_dem).map(|(h, c)| (h - c).abs()),
+            ContrastKind::WallBed => wall_temperature.map(|w| (w - bed_mean_dem).abs()),
+            ContrastKind::None => None,
+        }
+        .filter(|s| *s > 0.0);
+        // the DEM runs at t_k: the reference, then every further run that reached t_k
+        let (at_k, at_k_groups): (Vec<&Snapshot>, Vec<&HotCold>) = others
+            .iter()
+            .zip(&run_groups)
+            .filter_map(|(o, g)| Some((o.iter().find(|s| s.index == k)?, g)))
+            .unzip();
+        let runs: Vec<Field> = std::iter::once(dem_after)
+            .chain(at_k.iter().copied())
+            .map(|s| Field {
+                pos: &s.pos,
+                temp: &s.temp,
+            })
+            .collect();
+        let floor = floor::floor(&cells_v, &runs, &extra_means);
+        // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
+        // has no snapshot at t1, where it is the reference
+        let floor_energy_error = others
+            .iter()
+            .filter_map(|o| {
+                let twin_after = o.iter().find(|s| s.index == k)?;
+                let twin_before = o
+                    .iter()
+                    .find(|s| s.index == before.index)
+                    .map_or(&dem_before.temp, |s| &s.temp);
+                metrics::energy_error(
+                    &dem_before.temp,
+                    &dem_after.temp,
+                    twin_before,
+                    &twin_after.temp,
+                )
+            })
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()));
         periods.push(PeriodComparison {
             k,
             t: after.time,
             eps_abs,
             cells_used,
-            eps_rel: scale.filter(|s| *s > 0.0).map(|s| eps_abs / s),
+            eps_rel: scale.map(|s| eps_abs / s),
             energy_error: metrics::energy_error(
                 &dem_before.temp,
                 &dem_after.temp,
@@ -255,6 +435,30 @@ pub fn compare_with(
             hot_mean_extra: hot_extra,
             cold_mean_dem: cold_dem,
             cold_mean_extra: cold_extra,
+            bed_mean_dem,
+            bed_mean_extra: metrics::bed_mean(&after.radius, &after.temp),
+            contrast: scale,
+            floor_eps_abs: floor.as_ref().map(|f| f.floor_eps_abs),
+            floor_eps_abs_min: floor.as_ref().map(|f| f.floor_eps_abs_min),
+            floor_eps_abs_max: floor.as_ref().map(|f| f.floor_eps_abs_max),
+            floor_eps_rel: floor.as_ref().zip(scale).map(|(f, s)| f.floor_eps_abs / s),
+            eps_abs_to_dem_runs: floor.as_ref().map(|f| f.eps_abs_to_dem_runs),
+            ratio_to_floor: floor.as_ref().and_then(|f| f.ratio_to_floor),
+            floor_energy_error,
+            dem_runs_hot_mean: at_k
+                .iter()
+                .zip(&at_k_groups)
+                .filter_map(|(s, g)| means_in(g, &s.temp).0)
+                .collect(),
+            dem_runs_cold_mean: at_k
+                .iter()
+                .zip(&at_k_groups)
+                .filter_map(|(s, g)| means_in(g, &s.temp).1)
+                .collect(),
+            dem_runs_bed_mean: at_k
+                .iter()
+                .map(|s| metrics::bed_mean(&s.radius, &s.temp))
+                .collect(),
         });
     }
     if periods.is_empty() {
@@ -266,6 +470,7 @@ pub fn compare_with(
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
+    let verdict = Verdict::of(&periods, 1 + others.len(), contrast_kind);
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,
@@ -275,8 +480,12 @@ pub fn compare_with(
         seed,
         hot_particles,
         cold_particles,
+        dem_runs: 1 + others.len(),
+        contrast: contrast_kind,
         periods,
         dem_series,
+        dem_runs_series,
+        verdict,
         unreferenced,
     })
 }
@@ -318,14 +527,17 @@ fn opt(x: Option<f64>, scale: f64, digits: usize) -> String {
     x.map_or("-".into(), |v| format!("{:.digits$}", v * scale))
 }
 
-/// The terminal table (Table 5 form, plus the group means).
+/// The terminal table (Table 5 form, plus the group means; with DEM twins the floor and
+/// the ratio), then the verdict.
 pub fn table(c: &Comparison) -> String {
     let (hot, cold) = match c.second {
         SecondKind::Extrapolation => ("hot extra", "cold ext"),
         SecondKind::Dem => ("hot DEM 2", "cold DEM2"),
     };
+    let groups = c.hot_particles > 0;
+    let floors = c.periods.iter().any(|p| p.floor_eps_abs.is_some());
     let mut s = format!(
-        "{}{} vs {}: {} particles, {} Voronoi cells (seed {}), {} hot / {} cold\n",
+        "{}{} vs {}: {} particles, {} Voronoi cells (seed {}), {}\n",
         match c.second {
             SecondKind::Extrapolation => "",
             SecondKind::Dem => "second DEM run ",
@@ -335,30 +547,74 @@ pub fn table(c: &Comparison) -> String {
         c.particles,
         c.cells,
         c.seed,
-        c.hot_particles,
-        c.cold_particles
+        if groups {
+            format!("{} hot / {} cold", c.hot_particles, c.cold_particles)
+        } else {
+            "no hot and cold groups (uniform start)".to_string()
+        }
     );
-    s += &format!(
-        "{:>4} {:>9} {:>10} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
-        "k", "t (s)", "eps_abs K", "eps_rel%", "eq10 %", "hot DEM", hot, "cold DEM", cold
-    );
-    for p in &c.periods {
+    s += match c.contrast {
+        ContrastKind::HotCold => "eps_rel = eps_abs / (hot − cold mean of the DEM)",
+        ContrastKind::WallBed => "eps_rel = eps_abs / (wall − bed mean of the DEM)",
+        ContrastKind::None => "eps_rel: no temperature contrast to divide by",
+    };
+    if floors {
         s += &format!(
-            "{:>4} {:>9.3} {:>10.5} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+            "; floor = eps_abs between {} DEM runs (mean, max); ratio = the second field's \
+             mean eps_abs to them / mean floor",
+            c.dem_runs
+        );
+    }
+    s += "; temperatures in K\n";
+    let mut head = format!(
+        "{:>4} {:>8} {:>9} {:>8} {:>8}",
+        "k", "t (s)", "eps_abs", "eps_rel%", "eq10 %"
+    );
+    if floors {
+        head += &format!(" {:>9} {:>9} {:>6}", "floor", "floor max", "ratio");
+    }
+    if groups {
+        head += &format!(" {:>9} {:>9} {:>9} {:>9}", "hot DEM", hot, "cold DEM", cold);
+    } else {
+        head += &format!(" {:>9} {:>9}", "bed DEM", "bed 2nd");
+    }
+    s += &head;
+    s += "\n";
+    for p in &c.periods {
+        let mut line = format!(
+            "{:>4} {:>8} {:>9.5} {:>8} {:>8}",
             p.k,
-            p.t,
+            format!("{:.3}", p.t),
             p.eps_abs,
             opt(p.eps_rel, 100.0, 3),
             opt(p.energy_error, 100.0, 3),
-            opt(p.hot_mean_dem, 1.0, 4),
-            opt(p.hot_mean_extra, 1.0, 4),
-            opt(p.cold_mean_dem, 1.0, 4),
-            opt(p.cold_mean_extra, 1.0, 4),
         );
+        if floors {
+            line += &format!(
+                " {:>9} {:>9} {:>6}",
+                opt(p.floor_eps_abs, 1.0, 5),
+                opt(p.floor_eps_abs_max, 1.0, 5),
+                p.ratio_to_floor.map_or("-".into(), verdict::num)
+            );
+        }
+        if groups {
+            line += &format!(
+                " {:>9} {:>9} {:>9} {:>9}",
+                opt(p.hot_mean_dem, 1.0, 4),
+                opt(p.hot_mean_extra, 1.0, 4),
+                opt(p.cold_mean_dem, 1.0, 4),
+                opt(p.cold_mean_extra, 1.0, 4),
+            );
+        } else {
+            line += &format!(" {:>9.4} {:>9.4}", p.bed_mean_dem, p.bed_mean_extra);
+        }
+        s += &line;
+        s += "\n";
     }
     if !c.unreferenced.is_empty() {
         s += &format!("no DEM reference for t_k, k = {:?}\n", c.unreferenced);
     }
+    s += &format!("verdict: {}\n", c.verdict.text);
     s
 }
 
@@ -366,11 +622,11 @@ pub fn table(c: &Comparison) -> String {
 pub fn csv(c: &Comparison) -> String {
     let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let mut s = String::from(
-        "k,t,eps_abs,eps_rel,energy_error,cells_used,hot_mean_dem,hot_mean_extra,cold_mean_dem,cold_mean_extra\n",
+        "k,t,eps_abs,eps_rel,energy_error,cells_used,hot_mean_dem,hot_mean_extra,cold_mean_dem,cold_mean_extra,bed_mean_dem,bed_mean_extra,floor_eps_abs,floor_eps_abs_max,floor_eps_rel,ratio_to_floor\n",
     );
     for p in &c.periods {
         s += &format!(
-            "{},{:e},{:e},{},{},{},{},{},{},{}\n",
+            "{},{:e},{:e},{},{},{},{},{},{},{},{:e},{:e},{},{},{},{}\n",
             p.k,
             p.t,
             p.eps_abs,
@@ -380,7 +636,13 @@ pub fn csv(c: &Comparison) -> String {
             f(p.hot_mean_dem),
             f(p.hot_mean_extra),
             f(p.cold_mean_dem),
-            f(p.cold_mean_extra)
+            f(p.cold_mean_extra),
+            p.bed_mean_dem,
+            p.bed_mean_extra,
+            f(p.floor_eps_abs),
+            f(p.floor_eps_abs_max),
+            f(p.floor_eps_rel),
+            f(p.ratio_to_floor)
         );
     }
     s

@@ -117,6 +117,7 @@ mod tests {
             seconds_period: 3900.0 + 7619.0,
             seconds_reference: 0.0,
             seconds_recorder: 7619.0,
+            seconds_twins: 0.0,
             stage_seconds: Default::default(),
             threads: 1,
         };

@@ -1,17 +1,24 @@
-//! `tdex report`: a self-contained report of an extrapolation against its recording
-//! (DESIGN.md §7): `report.md` and `report.html` with the error table (Table 5 form), the
-//! cost table (Table 6 form) and SVG plots (Figures 7 and 9, errors, speedup, the field).
+//! `tdex report`: a self-contained report of an extrapolation (docs/method.md §7): `report.md` and
+//! `report.html` opening with a summary of what was predicted, the prediction over all
+//! extrapolated periods (bed and group means, the walls' heat, the spread, the mixing, the
+//! field), and where the recording has a DEM reference the error table (Table 5 form)
+//! against it; the cost table (Table 6 form) and SVG plots.
 
 mod content;
 pub(crate) mod costs;
 mod document;
 pub(crate) mod plots;
+pub mod prediction;
 
 use crate::cli::ReportPlan;
 use crate::compare::{self, Comparison};
 use anyhow::{Context, Result};
-use content::{DURATIONS_SVG, ERRORS_SVG, FIELD_SVG, MEANS_SVG, SPEEDUP_SVG};
+use content::{
+    BED_MEAN_SVG, DURATIONS_SVG, ERRORS_SVG, FIELDS_SVG, FIELD_SVG, LACEY_SVG, MEANS_SVG,
+    SPEEDUP_SVG, SPREAD_SVG, WALL_HEAT_SVG,
+};
 use costs::CostTable;
+use prediction::{Measures, Prediction};
 use recorder::format::{ExtrapolationReader, RecordingReader};
 use recorder::output::OutputSet;
 use std::path::{Path, PathBuf};
@@ -20,10 +27,15 @@ use std::path::{Path, PathBuf};
 /// removed once the new report is in place.
 const MARKDOWN: &str = "report.md";
 const HTML: &str = "report.html";
-const ALL_FILES: [&str; 7] = [
+const ALL_FILES: [&str; 12] = [
     MARKDOWN,
     HTML,
+    BED_MEAN_SVG,
     MEANS_SVG,
+    WALL_HEAT_SVG,
+    SPREAD_SVG,
+    LACEY_SVG,
+    FIELDS_SVG,
     ERRORS_SVG,
     SPEEDUP_SVG,
     DURATIONS_SVG,
@@ -33,8 +45,35 @@ const ALL_FILES: [&str; 7] = [
 pub fn run(plan: &ReportPlan) -> Result<()> {
     let recording = RecordingReader::open(&plan.recording)?;
     let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
-    let comparison = compare::compare(&recording, &extrapolation, plan.cells, plan.seed)?;
-    let files = write(&plan.output, &recording, &extrapolation, &comparison)?;
+    let comparison = if recording.info().reference_periods > 0 {
+        let dem_runs = compare::open_dem_runs(&plan.dem_runs)?;
+        let dem_runs: Vec<&RecordingReader> = dem_runs.iter().collect();
+        Some(compare::compare_runs(
+            &recording,
+            compare::Second::Extrapolation(&extrapolation),
+            &dem_runs,
+            plan.cells,
+            plan.seed,
+        )?)
+    } else if let Some(run) = plan.dem_runs.first() {
+        return Err(crate::cli::UsageError(format!(
+            "{} has no DEM reference to measure further DEM runs such as {} against: record it \
+             with --reference K to compare",
+            recording.path().display(),
+            run.display()
+        ))
+        .into());
+    } else {
+        None
+    };
+    let files = write_with(
+        &plan.output,
+        &recording,
+        &extrapolation,
+        comparison.as_ref(),
+        plan.cells,
+        plan.seed,
+    )?;
     for f in files {
         println!("{}", f.display());
     }
@@ -44,15 +83,72 @@ pub fn run(plan: &ReportPlan) -> Result<()> {
 /// Writes the report into `dir` (created if missing); returns the files written. Every file
 /// is written and fsynced to a temporary name first and renamed into place only when all
 /// are (plots first, the two reports last): a full disk leaves the previous report whole.
+/// `comparison` is the extrapolation against the recording's DEM reference (None without
+/// one); the Lacey index is computed on the comparison's Voronoi cells, or on the default
+/// ones without a comparison.
 pub fn write(
     dir: &Path,
     recording: &RecordingReader,
     extrapolation: &ExtrapolationReader,
-    comparison: &Comparison,
+    comparison: Option<&Comparison>,
+) -> Result<Vec<PathBuf>> {
+    let (cells, seed) = comparison.map_or((compare::DEFAULT_CELLS, compare::DEFAULT_SEED), |c| {
+        (c.cells, c.seed)
+    });
+    write_with(dir, recording, extrapolation, comparison, cells, seed)
+}
+
+/// [`write`] with the Voronoi cells of the Lacey index drawn as the comparison draws its own:
+/// `cells` of them (fewer for a small bed, see [`prediction::LACEY_MIN_PER_CELL`]) from
+/// `seed`.
+pub fn write_with(
+    dir: &Path,
+    recording: &RecordingReader,
+    extrapolation: &ExtrapolationReader,
+    comparison: Option<&Comparison>,
+    cells: usize,
+    seed: u64,
 ) -> Result<Vec<PathBuf>> {
     recorder::output::create_dir_all(dir)?;
     let info = recording.info();
     let rec_path = recording.path().display().to_string();
+    let extra_path = extrapolation.path().display().to_string();
+
+    if extrapolation.info().recording_info != *info {
+        return Err(crate::cli::UsageError(format!(
+            "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
+             recordings' metadata differ)",
+            extrapolation.info().recording
+        ))
+        .into());
+    }
+    let dem = recording
+        .snapshots()
+        .with_context(|| format!("{rec_path}: cannot read the snapshots"))?;
+    let (i0, i1) = prediction::t0_t1(&dem, &rec_path)?;
+    let measures = Measures::new(info, &dem[i0], &dem[i1], cells, seed);
+    let extra_snaps = extrapolation
+        .snapshots()
+        .with_context(|| format!("{extra_path}: cannot read the extrapolated snapshots"))?;
+    let extra_at = |k: u32| extra_snaps.iter().find(|s| s.index == k).cloned();
+    let field_snap = comparison.and_then(|c| c.periods.last()).map(|last| last.k);
+    let field_extra = field_snap.and_then(extra_at);
+    let pred = Prediction::new(info, &measures, extra_snaps)
+        .with_context(|| format!("{extra_path}: nothing to report"))?;
+    // the DEM's own spread and mixing where the recording has a reference: the reference,
+    // then its twins
+    let dem_points: Vec<Vec<prediction::Point>> = if comparison.is_some() {
+        let mut v = vec![prediction::dem_points(&measures, &dem)];
+        for twin in recording
+            .twin_snapshots()
+            .with_context(|| format!("{rec_path}: cannot read the twins' snapshots"))?
+        {
+            v.push(prediction::dem_points(&measures, &twin));
+        }
+        v
+    } else {
+        Vec::new()
+    };
 
     let costs = match (recording.costs(), extrapolation.costs()) {
         (Some(rc), Some(ec)) => {
@@ -72,8 +168,7 @@ pub fn write(
             "{rec_path} has no costs record (its writer was interrupted)"
         )),
         (_, None) => Err(format!(
-            "{} has no costs record (its writer was interrupted)",
-            extrapolation.path().display()
+            "{extra_path} has no costs record (its writer was interrupted)"
         )),
     };
 
@@ -81,13 +176,55 @@ pub fn write(
     let plot = |name: &str, r: Result<String>| {
         r.with_context(|| format!("{}: cannot draw the plot", dir.join(name).display()))
     };
-    svgs.push((MEANS_SVG, plot(MEANS_SVG, plots::means(comparison))?));
-    svgs.push((ERRORS_SVG, plot(ERRORS_SVG, plots::errors(comparison))?));
-    if let Ok(t) = &costs {
+    svgs.push((
+        BED_MEAN_SVG,
+        plot(BED_MEAN_SVG, plots::bed_mean(&pred, comparison))?,
+    ));
+    if pred.has_groups() {
         svgs.push((
-            SPEEDUP_SVG,
-            plot(SPEEDUP_SVG, plots::error_vs_speedup(comparison, t))?,
+            MEANS_SVG,
+            plot(MEANS_SVG, plots::group_means(&pred, comparison))?,
         ));
+    }
+    if pred.wall_heat().is_some() {
+        svgs.push((
+            WALL_HEAT_SVG,
+            plot(WALL_HEAT_SVG, plots::wall_heat(&pred, comparison))?,
+        ));
+    }
+    svgs.push((
+        SPREAD_SVG,
+        plot(SPREAD_SVG, plots::spread(&pred, &dem_points))?,
+    ));
+    if pred.has_groups() {
+        svgs.push((
+            LACEY_SVG,
+            plot(LACEY_SVG, plots::lacey(&pred, &dem_points))?,
+        ));
+    }
+    let panels: Vec<(&recorder::format::Snapshot, String)> = pred
+        .fields
+        .iter()
+        .map(|s| {
+            let what = if s.index == 1 { ", DEM state" } else { "" };
+            (
+                s,
+                format!("t{} (t = {} s{what})", s.index, plots::tick(s.time)),
+            )
+        })
+        .collect();
+    svgs.push((
+        FIELDS_SVG,
+        plot(FIELDS_SVG, plots::fields(&panels, pred.drum_radius))?,
+    ));
+    if let Some(c) = comparison {
+        svgs.push((ERRORS_SVG, plot(ERRORS_SVG, plots::errors(c))?));
+        if let Ok(t) = &costs {
+            svgs.push((
+                SPEEDUP_SVG,
+                plot(SPEEDUP_SVG, plots::error_vs_speedup(c, t))?,
+            ));
+        }
     }
     if let Some(summary) = recording.summary() {
         svgs.push((
@@ -102,36 +239,21 @@ pub fn write(
             )?,
         ));
     }
-    let field = match comparison.periods.last() {
-        None => Err("no extrapolated t_k has a DEM reference".to_string()),
-        Some(last) => {
-            let k = last.k;
-            let dem = recording
-                .snapshot(k)
-                .with_context(|| format!("{rec_path}: cannot read the snapshot at t_{k}"))?;
-            let extra = extrapolation
-                .snapshots()
-                .with_context(|| {
-                    format!(
-                        "{}: cannot read the extrapolated snapshots",
-                        extrapolation.path().display()
-                    )
-                })?
-                .into_iter()
-                .find(|s| s.index == k);
-            match (dem, extra) {
-                (Some(dem), Some(extra)) => {
-                    svgs.push((FIELD_SVG, plot(FIELD_SVG, plots::field(&dem, &extra, k))?));
-                    Ok(k)
-                }
-                (None, _) => Err(format!("{rec_path} has no DEM snapshot at t_{k}")),
-                (_, None) => Err(format!(
-                    "{} has no snapshot at t_{k}",
-                    extrapolation.path().display()
-                )),
+    let field = field_snap.map(|k| {
+        let dem_k = dem.iter().find(|s| s.index == k);
+        match (dem_k, &field_extra) {
+            (Some(dem_k), Some(extra)) => {
+                svgs.push((
+                    FIELD_SVG,
+                    plot(FIELD_SVG, plots::field(dem_k, extra, k, pred.drum_radius))?,
+                ));
+                Ok::<_, anyhow::Error>(Ok(k))
             }
+            (None, _) => Ok(Err(format!("{rec_path} has no DEM snapshot at t_{k}"))),
+            (_, None) => Ok(Err(format!("{extra_path} has no snapshot at t_{k}"))),
         }
-    };
+    });
+    let field = field.transpose()?;
 
     let doc = content::document(&content::Inputs {
         recording_path: rec_path.clone(),
@@ -139,6 +261,7 @@ pub fn write(
         info,
         extrapolation: extrapolation.info(),
         summary: recording.summary(),
+        prediction: &pred,
         comparison,
         costs,
         field,

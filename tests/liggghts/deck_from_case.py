@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write a LIGGGHTS 3.8 deck and the drum STL for a tdex case file.
 
-usage: deck_from_case.py CASE.toml OUTDIR [--dumps N PERIODS [--per-proc]]
+usage: deck_from_case.py CASE.toml OUTDIR [--dumps N PERIODS [--per-proc] [--from-t1-period P]]
 
 Writes OUTDIR/in.drum (every value of the case substituted, paths relative to
 OUTDIR: run it from there) and the drum mesh: OUTDIR/drum.stl (mantle + both end
@@ -16,6 +16,11 @@ first revolution (dump_pairs.STEP); with --per-proc the atoms go to one file per
 process and timestep (dump_atoms.STEP.PROC; LIGGGHTS 3.8 writes no header in the `dump local`
 files of processes other than 0, so the contacts are always gathered into one file).  t0 must then be a whole number of revolutions and
 of N steps (choose time.settle + time.spin_up accordingly).
+
+With --from-t1-period P the drum's rotation is defined anew at t1 (after the recorded
+revolution) with the period P s: run once with the case's own period and once per twin with
+P changed in its last digits, and the runs are the same to t1 (LIGGGHTS is reproducible to the
+last digit) and part from t1 on, as `tdex record --twins` does (docs/validation.md).
 """
 import math
 import re
@@ -82,11 +87,18 @@ dump dc all local @n@ dump_pairs.* c_pc[1] c_pc[2] c_pc[3] c_pc[4]
 dump_modify dc format "%.0f %.0f %.0f %.17g"
 run @nper@
 undump dc
+@restart_rotation@
 run @nrest@"""
 
 
-def import_dumps(argv, nper, nstart):
-    """The heating runs of a deck that writes the import dumps (--dumps N PERIODS [--per-proc])."""
+def import_dumps(argv, nper, nstart, rotating):
+    """The heating runs of a deck that writes the import dumps
+    (--dumps N PERIODS [--per-proc] [--from-t1-period P])."""
+    restart = ""
+    if len(argv) >= 2 and argv[-2] == "--from-t1-period":
+        restart = (f"unfix rot\nfix rot all move/mesh mesh {rotating} rotate origin 0. 0. 0. "
+                   f"axis 0. 1. 0. period {float(argv[-1])!r}")
+        argv = argv[:-2]
     if len(argv) not in (3, 4) or argv[0] != "--dumps" or argv[3:] not in ([], ["--per-proc"]):
         sys.exit(__doc__)
     n, periods = int(argv[1]), int(argv[2])
@@ -94,7 +106,7 @@ def import_dumps(argv, nper, nstart):
         sys.exit(f"--dumps {n} {periods}: t0 = step {nstart} must be a multiple of one revolution "
                  f"({nper} steps), itself a multiple of n = {n}")
     v = dict(n=n, periods=periods, nper=nper, nrest=periods * nper,
-             proc=".%" if argv[3:] else "")
+             proc=".%" if argv[3:] else "", restart_rotation=restart)
     return re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), IMPORT_DUMPS)
 
 
@@ -160,7 +172,7 @@ def main():
     nper = steps(drum["rotation_period"], dt, "drum.rotation_period")
     # LIGGGHTS wants compute pair/gran/local defined before the first run
     v["pair_compute"] = "compute pc all pair/gran/local id contactArea" if len(sys.argv) > 3 else ""
-    v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"])
+    v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"], rotating)
                       if len(sys.argv) > 3 else f"run {v['nheat']}")
     deck = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), DECK)
     (out / "in.drum").write_text(deck)

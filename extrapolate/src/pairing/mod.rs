@@ -1,4 +1,4 @@
-//! Pairing of the t0 and t1 snapshots (DESIGN.md §5; Haydar et al. 2023 §2.1.2,
+//! Pairing of the t0 and t1 snapshots (docs/method.md §5; Haydar et al. 2023 §2.1.2,
 //! Bednarek et al. 2019): the bijection `g` that minimises `Σ_p |x1[p] − x0[g(p)]|`
 //! (Euclidean distance, not squared). At t1 particle `p` stands where `g(p)` stood at
 //! t0, so in the next period `p` plays the role of `g(p)`.
@@ -22,6 +22,7 @@
 mod candidates;
 mod certificate;
 mod cost;
+pub mod cycles;
 mod dense;
 mod feasibility;
 mod order;
@@ -29,6 +30,7 @@ mod sparse_lap;
 
 use std::time::Instant;
 
+pub use cycles::{cycle_structure, CycleStructure, SHORT_CYCLE};
 pub use dense::DENSE_LIMIT;
 
 /// Options of [`pair`].

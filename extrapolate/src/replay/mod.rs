@@ -1,4 +1,4 @@
-//! Replay of a recorded collision table through the pairing (DESIGN.md §6, Haydar
+//! Replay of a recorded collision table through the pairing (docs/method.md §6, Haydar
 //! Algorithm 3): temperatures live per role, move to their new roles at each period
 //! boundary, and every row exchanges heat between its two bodies.
 

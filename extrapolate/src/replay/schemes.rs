@@ -1,4 +1,4 @@
-//! The three ways of applying a period's rows (DESIGN.md §6). All conserve `Σ C T` between
+//! The three ways of applying a period's rows (docs/method.md §6). All conserve `Σ C T` between
 //! particles; a wall row adds the heat the wall gives.
 
 use super::table::{Bodies, Exchange};

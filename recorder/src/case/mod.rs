@@ -12,10 +12,12 @@ use std::path::{Path, PathBuf};
 /// field, the offending value and what is allowed.
 #[derive(Debug, thiserror::Error)]
 pub enum CaseError {
-    #[error("cannot read case file {}: {source}", path.display())]
+    /// The I/O error is in the message and not also the error's `source()` (a chain
+    /// printed with `{:#}` would say it twice).
+    #[error("cannot read case file {}: {error}", path.display())]
     Read {
         path: PathBuf,
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error("{}: not a valid case file: {message}", path.display())]
     Parse { path: PathBuf, message: String },
@@ -35,9 +37,9 @@ pub fn load(path: &Path) -> Result<Case, CaseError> {
 
 /// [`load`], also returning the file's text as given (a recording stores it).
 pub fn load_with_text(path: &Path) -> Result<(Case, String), CaseError> {
-    let bytes = std::fs::read(path).map_err(|source| CaseError::Read {
+    let bytes = std::fs::read(path).map_err(|error| CaseError::Read {
         path: path.to_path_buf(),
-        source,
+        error,
     })?;
     parse_bytes(&bytes, path)
 }

@@ -37,6 +37,19 @@ fn positive(field: &str, v: f64) -> Result<(), Violation> {
     }
 }
 
+/// A temperature, in kelvin: finite and > 0 K (the message says the unit).
+fn temperature(field: &str, v: f64) -> Result<(), Violation> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(refuse(
+            field,
+            format!("{v} K"),
+            "must be a finite temperature > 0 K (temperatures are in kelvin)",
+        ))
+    }
+}
+
 fn non_negative(field: &str, v: f64) -> Result<(), Violation> {
     if v.is_finite() && v >= 0.0 {
         Ok(())
@@ -126,7 +139,7 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
     }
     positive("drum.rotation_period", d.rotation_period)?;
     if let Some(tw) = d.wall_temperature {
-        positive("drum.wall_temperature", tw)?;
+        temperature("drum.wall_temperature", tw)?;
     }
     if let Some(kw) = d.wall_conductivity {
         positive("drum.wall_conductivity", kw)?;
@@ -171,12 +184,12 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
                     "required when mode = \"split\"",
                 )
             })?;
-            positive("temperature.hot", hot)?;
-            positive("temperature.cold", cold)?;
+            temperature("temperature.hot", hot)?;
+            temperature("temperature.cold", cold)?;
             if let Some(v) = temp.value {
                 return Err(refuse(
                     "temperature.value",
-                    v,
+                    format!("{v} K"),
                     "only allowed when mode = \"uniform\"",
                 ));
             }
@@ -189,11 +202,11 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
                     "required when mode = \"uniform\"",
                 )
             })?;
-            positive("temperature.value", v)?;
+            temperature("temperature.value", v)?;
             if let Some(h) = temp.hot.or(temp.cold) {
                 return Err(refuse(
                     "temperature.hot/cold",
-                    h,
+                    format!("{h} K"),
                     "only allowed when mode = \"split\"",
                 ));
             }

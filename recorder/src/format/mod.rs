@@ -1,4 +1,4 @@
-//! The recording file (MCAP, DESIGN.md §4; layout in docs/file-format.md): what a recording
+//! The recording file (MCAP, docs/method.md §4; layout in docs/file-format.md): what a recording
 //! holds, the writer used by `tdex record` and the streaming reader used by `extrapolate`.
 
 pub mod extrapolation;
@@ -27,6 +27,12 @@ pub const PROFILE: &str = "tdex";
 pub const FORMAT_VERSION: u32 = 1;
 /// Channel of the particle snapshots (`foxglove.PointCloud`).
 pub const SNAPSHOT_TOPIC: &str = "/tdex/snapshots";
+/// Channel of DEM twin `m`'s snapshots (`foxglove.PointCloud`): `/tdex/twins/<m>`, m ≥ 1.
+pub fn twin_topic(twin: u32) -> String {
+    format!("/tdex/twins/{twin}")
+}
+/// Most DEM twins a recording may hold (each costs the reference periods again).
+pub const MAX_TWINS: u32 = 16;
 /// Channel of the collision table (`tdex.CollisionBatch`).
 pub const COLLISION_TOPIC: &str = "/tdex/collisions";
 /// Metadata record written first: [`RecordingInfo`] as JSON under the key `json`.
@@ -90,6 +96,12 @@ pub struct RecordingInfo {
     pub step_t0: u64,
     /// Reference periods stored after `t1` (`--reference K`).
     pub reference_periods: u32,
+    /// DEM twins (`--twins M`): further DEM runs continued from the state at `t1`, each with
+    /// the drum's angular velocity changed in its last bits, stored at the same reference
+    /// `t_k` on channels [`twin_topic`]. Absent from the JSON when 0, so that a recording
+    /// without twins is the same bytes as before twins existed.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub twins: u32,
     pub area_encoding: AreaEncoding,
     /// Metres per `sqrt(a)` code (quantised encoding), else 0.
     pub sqrt_area_unit: f64,
@@ -144,6 +156,16 @@ impl RecordingInfo {
                 );
             }
         }
+        if self.twins > MAX_TWINS || (self.twins > 0 && self.reference_periods == 0) {
+            return bad(
+                "twins",
+                &self.twins,
+                &format!(
+                    "must be at most {MAX_TWINS}, and 0 without reference periods (here {})",
+                    self.reference_periods
+                ),
+            );
+        }
         for (field, value) in [
             ("sample_every", self.sample_every as u64),
             ("dtc_max_steps", self.dtc_max_steps as u64),
@@ -195,6 +217,14 @@ impl RecordingInfo {
     }
 }
 
+fn is_zero(x: &u32) -> bool {
+    *x == 0
+}
+
+fn is_zero_f64(x: &f64) -> bool {
+    *x == 0.0
+}
+
 /// What the recorded period holds; written after the table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RecordingSummary {
@@ -219,6 +249,9 @@ pub struct RecordingCosts {
     pub seconds_reference: f64,
     /// Of `seconds_period`, the time spent sampling, splitting, encoding and writing.
     pub seconds_recorder: f64,
+    /// The DEM twins' reference periods, all twins (absent without twins).
+    #[serde(default, skip_serializing_if = "is_zero_f64")]
+    pub seconds_twins: f64,
     /// Per-stage DEM seconds over the whole run.
     pub stage_seconds: BTreeMap<String, f64>,
     pub threads: usize,

@@ -14,6 +14,8 @@ pub struct RecordingReader {
     run_summary: Option<RecordingSummary>,
     costs: Option<RecordingCosts>,
     snapshot_channel: u16,
+    /// Channel of twin `m` at `m - 1`.
+    twin_channels: Vec<u16>,
     collision_channel: u16,
 }
 
@@ -57,7 +59,11 @@ impl RecordingReader {
         let costs = file.metadata(COSTS_METADATA)?;
         let snapshot_channel = file.channel(SNAPSHOT_TOPIC, "foxglove.PointCloud")?;
         let collision_channel = file.channel(COLLISION_TOPIC, "tdex.CollisionBatch")?;
+        let twin_channels = (1..=info.twins)
+            .map(|m| file.channel(&twin_topic(m), "foxglove.PointCloud"))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
+            twin_channels,
             file,
             info,
             run_summary,
@@ -127,8 +133,35 @@ impl RecordingReader {
 
     /// All snapshots, by index (0: `t0`, 1: `t1`, then the reference periods).
     pub fn snapshots(&self) -> Result<Vec<Snapshot>, FormatError> {
+        self.snapshots_on(self.snapshot_channel)
+    }
+
+    /// The DEM twins' reference snapshots: entry `m - 1` holds twin `m`'s, by index
+    /// (`t2` on: a twin parts from the DEM at `t1`). Empty without twins.
+    pub fn twin_snapshots(&self) -> Result<Vec<Vec<Snapshot>>, FormatError> {
+        let twins: Vec<Vec<Snapshot>> = self
+            .twin_channels
+            .iter()
+            .map(|&c| self.snapshots_on(c))
+            .collect::<Result<_, _>>()?;
+        for (m, snaps) in twins.iter().enumerate() {
+            let expected = self.info.reference_periods as usize;
+            if snaps.len() != expected || snaps.iter().zip(2..).any(|(s, k)| s.index != k) {
+                return Err(self.corrupt(format!(
+                    "twin {}: {} snapshots numbered {:?}; a twin holds one at each of t2..t{}",
+                    m + 1,
+                    snaps.len(),
+                    snaps.iter().map(|s| s.index).collect::<Vec<_>>(),
+                    expected + 1
+                )));
+            }
+        }
+        Ok(twins)
+    }
+
+    fn snapshots_on(&self, channel: u16) -> Result<Vec<Snapshot>, FormatError> {
         let mut snaps = Vec::new();
-        for m in self.file.messages_at(self.snapshot_channel, None) {
+        for m in self.file.messages_at(channel, None) {
             let (index, data) = m?;
             snaps.push(self.decode_snapshot(index, &data)?);
         }

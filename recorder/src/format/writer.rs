@@ -17,6 +17,8 @@ pub struct RecordingWriter {
     info: RecordingInfo,
     dest: PathBuf,
     snapshot_channel: u16,
+    /// Channel of twin `m` at `m - 1`.
+    twin_channels: Vec<u16>,
     collision_channel: u16,
     pending: Vec<CollisionRow>,
     rows_written: u64,
@@ -57,11 +59,23 @@ impl RecordingWriter {
                 &BTreeMap::new(),
             )
             .map_err(mcap_err)?;
+        let twin_channels = (1..=info.twins)
+            .map(|m| {
+                mcap.add_channel(
+                    snapshot_schema,
+                    &twin_topic(m),
+                    "protobuf",
+                    &BTreeMap::new(),
+                )
+                .map_err(mcap_err)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             mcap: Some(mcap),
             info,
             dest: dest.to_path_buf(),
             snapshot_channel,
+            twin_channels,
             collision_channel,
             pending: Vec::with_capacity(BATCH_ROWS),
             rows_written: 0,
@@ -81,15 +95,32 @@ impl RecordingWriter {
 
     /// Stores a snapshot in its own chunk (the table chunks then hold only table rows).
     pub fn write_snapshot(&mut self, snapshot: &Snapshot) -> Result<(), FormatError> {
+        self.snapshots += 1;
+        self.write_snapshot_on(self.snapshot_channel, snapshot)
+    }
+
+    /// Stores a snapshot of DEM twin `twin` (1-based, at most the info's `twins`).
+    pub fn write_twin_snapshot(
+        &mut self,
+        twin: u32,
+        snapshot: &Snapshot,
+    ) -> Result<(), FormatError> {
+        let channel = *twin
+            .checked_sub(1)
+            .and_then(|m| self.twin_channels.get(m as usize))
+            .expect("twin numbers run from 1 to the recording's twins");
+        self.write_snapshot_on(channel, snapshot)
+    }
+
+    fn write_snapshot_on(&mut self, channel: u16, snapshot: &Snapshot) -> Result<(), FormatError> {
         let step = self.info.step_t0 + snapshot.index as u64 * self.info.period_steps;
         let time = self.nanos(step);
         let data = snapshot.encode();
         let mcap = self.mcap.as_mut().expect("not finished");
         let result = mcap
             .flush()
-            .and_then(|_| write_message(mcap, self.snapshot_channel, snapshot.index, time, &data))
+            .and_then(|_| write_message(mcap, channel, snapshot.index, time, &data))
             .and_then(|_| mcap.flush());
-        self.snapshots += 1;
         result.map_err(|e| self.mcap_err(e))
     }
 

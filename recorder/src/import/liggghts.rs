@@ -93,6 +93,7 @@ pub fn import(
     let reference_periods = atoms.snapshots.len() as u32 - 2;
     let opts = RecordOptions {
         reference_periods,
+        twins: 0,
         ..opts.clone()
     };
     let info = recording_info(case, case_path, case_toml, &opts, run);
@@ -169,6 +170,7 @@ pub fn import(
         seconds_period: 0.0,
         seconds_reference: 0.0,
         seconds_recorder: 0.0,
+        seconds_twins: 0.0,
         stage_seconds: Default::default(),
         threads: 0,
     };

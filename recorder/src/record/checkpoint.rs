@@ -31,8 +31,9 @@ use std::path::{Path, PathBuf};
 
 /// Format of the body; a reader refuses others. v2: the Verlet list's pair histories are
 /// packed layer by layer (v1 had one per entry). v3: one stage timer for pair and wall
-/// contacts (`contact`) instead of `pair` and `wall`.
-pub const CHECKPOINT_VERSION: u32 = 3;
+/// contacts (`contact`) instead of `pair` and `wall`. v4: DEM twins (the state at `t1` kept
+/// while the runs that continue from it go on, the twin stage, the twins' wall time).
+pub const CHECKPOINT_VERSION: u32 = 4;
 const HEADER_PREFIX: &str = "tdex checkpoint v";
 /// The header line is at most this long (a reader does not scan a large file for it).
 const MAX_HEADER: usize = 512;
@@ -48,6 +49,9 @@ pub enum Stage {
     Period { done: u64 },
     /// `done` steps into reference period `period` (0-based; the ones before it are stored).
     Reference { period: u32, done: u64 },
+    /// `done` steps into reference period `period` of DEM twin `twin` (1-based; the twins
+    /// before it and its periods before `period` are stored).
+    Twin { twin: u32, period: u32, done: u64 },
 }
 
 /// Wall-clock seconds spent so far, as the costs record reports them.
@@ -57,6 +61,8 @@ pub struct Elapsed {
     pub period: f64,
     pub recorder: f64,
     pub reference: f64,
+    /// The DEM twins' reference periods.
+    pub twins: f64,
 }
 
 /// The engine state a step depends on.
@@ -94,8 +100,11 @@ impl<'a> EngineState<'a> {
 #[derive(Debug, Serialize, Deserialize)]
 pub struct OutputState<'a> {
     pub run: RunAtT0,
-    /// `t0`, then `t1` and the reference snapshots written so far.
+    /// `t0`, then `t1` and the reference snapshots written so far, then those of the DEM
+    /// twins (twin 1's `t2..`, twin 2's, ...).
     pub snapshots: Cow<'a, [Snapshot]>,
+    /// The engine at `t1`, kept while DEM twins are still to continue from it.
+    pub t1_engine: Option<EngineState<'a>>,
     pub sampler: Cow<'a, ContactSampler>,
     pub journal: JournalMark,
 }
@@ -253,58 +262,13 @@ impl Checkpoint<'static> {
     /// index the engine and the recorder will follow is in range (a checkpoint that passed
     /// its CRC can still have been written by hand). `period_steps` and `reference_periods`
     /// bound the stage; `path` is for messages.
-    pub fn restore(
-        self,
-        case: &Case,
-        path: &Path,
-    ) -> Result<(Simulation, Stage, Elapsed, Option<OutputState<'static>>), CheckpointError> {
+    pub fn restore(self, case: &Case, path: &Path) -> Result<Restored, CheckpointError> {
         let bad = |detail: String| CheckpointError::Inconsistent {
             path: path.to_path_buf(),
             detail,
         };
-        let mut sim = Simulation::new(case).map_err(|e| bad(e.to_string()))?;
+        let sim = Simulation::new(case).map_err(|e| bad(e.to_string()))?;
         let n = sim.particles.len();
-        let e = self.engine;
-        e.particles.check(n).map_err(&bad)?;
-        // sizes and masses are the case's (the inserted set has them by id); the state is
-        // finite and inside the drum, as the engine keeps it
-        let inserted = &sim.particles;
-        let p = &e.particles;
-        for i in 0..n {
-            let id = p.id[i] as usize;
-            let finite = [p.pos[i], p.vel[i], p.omega[i], p.force[i], p.torque[i]]
-                .iter()
-                .flatten()
-                .chain([&p.temp[i], &p.heat_flow[i]])
-                .all(|x| x.is_finite());
-            if p.radius[i] != inserted.radius[id] || p.mass[i] != inserted.mass[id] || !finite {
-                return Err(bad(format!(
-                    "particle {id} (slot {i}): radius {} m, mass {} kg, or a non-finite state value; the case gives {} m, {} kg",
-                    p.radius[i], p.mass[i], inserted.radius[id], inserted.mass[id]
-                )));
-            }
-        }
-        e.neighbors
-            .check(n, sim.pipeline.grid.layers(), sim.walls.len())
-            .map_err(&bad)?;
-        if e.neighbors.skin != sim.neighbors.skin {
-            return Err(bad(format!(
-                "Verlet skin {} m, the case gives {} m",
-                e.neighbors.skin, sim.neighbors.skin
-            )));
-        }
-        if !e.groups.hot.is_empty() && e.groups.hot.len() != n {
-            return Err(bad(format!(
-                "{} group flags for {n} particles",
-                e.groups.hot.len()
-            )));
-        }
-        if e.time != e.step as f64 * case.time.dt {
-            return Err(bad(format!(
-                "t = {} s is not step {} × dt = {} s",
-                e.time, e.step, case.time.dt
-            )));
-        }
         let o = &self.options;
         let (settle, spin) = (
             case.steps_in(case.time.settle),
@@ -320,6 +284,12 @@ impl Checkpoint<'static> {
             Stage::Reference { period, done } => (
                 period < o.reference_periods && done <= o.period_steps,
                 Some(2 + period as usize),
+            ),
+            Stage::Twin { twin, period, done } => (
+                (1..=o.twins).contains(&twin)
+                    && period < o.reference_periods
+                    && done <= o.period_steps,
+                Some(2 + (o.reference_periods as usize) * twin as usize + period as usize),
             ),
         };
         if !stage_ok {
@@ -371,13 +341,37 @@ impl Checkpoint<'static> {
                 }
                 s.check(o.period_steps / o.sample_every.max(1) as u64)
                     .map_err(&bad)?;
+                // the main run's snapshots are numbered by position, each twin's from 2
+                let references = o.reference_periods.max(1) as usize;
+                let expected = |k: usize| match k.checked_sub(2 + references) {
+                    None => k,
+                    Some(past) => 2 + past % references,
+                };
                 if let Some((k, s)) = out
                     .snapshots
                     .iter()
                     .enumerate()
-                    .find(|(k, s)| s.index as usize != *k)
+                    .find(|(k, s)| s.index as usize != expected(*k))
                 {
                     return Err(bad(format!("snapshot {k} is numbered {}", s.index)));
+                }
+                // the state at t1 is kept from t1 on while twins are still to run from it
+                let keeps_t1 = match self.stage {
+                    Stage::Reference { .. } => o.twins > 0,
+                    Stage::Twin { .. } => true,
+                    _ => false,
+                };
+                if out.t1_engine.is_some() != keeps_t1 {
+                    return Err(bad(format!(
+                        "stage {:?} with {} twins {} the engine state at t1",
+                        self.stage,
+                        o.twins,
+                        if out.t1_engine.is_some() {
+                            "has"
+                        } else {
+                            "lacks"
+                        }
+                    )));
                 }
                 let (t0_step, r) = (settle + spin, case.particles.radius);
                 if out.run.step_t0 != t0_step
@@ -398,16 +392,90 @@ impl Checkpoint<'static> {
                 )))
             }
         }
-        sim.particles = e.particles.into_owned();
-        sim.neighbors = e.neighbors.into_owned();
-        sim.walls.angular_velocity = e.angular_velocity;
-        sim.walls.mantle_temperature = e.mantle_temperature;
-        sim.groups = e.groups.into_owned();
-        sim.time = e.time;
-        sim.step = e.step;
-        sim.last_contacts = e.last_contacts;
-        sim.counters = e.counters.into_owned();
-        sim.check_inside().map_err(|e| bad(e.to_string()))?;
-        Ok((sim, self.stage, self.elapsed, self.output))
+        let mut output = self.output;
+        let t1 = match output.as_mut().and_then(|o| o.t1_engine.take()) {
+            Some(e) => Some(apply(e, sim.clone(), case, &bad)?),
+            None => None,
+        };
+        let sim = apply(self.engine, sim, case, &bad)?;
+        Ok(Restored {
+            sim,
+            stage: self.stage,
+            elapsed: self.elapsed,
+            output,
+            t1,
+        })
     }
+}
+
+/// The state a run resumes from: the engine where it stood, and at `t1` when DEM twins
+/// are still to continue from there.
+pub struct Restored {
+    pub sim: Simulation,
+    pub stage: Stage,
+    pub elapsed: Elapsed,
+    pub output: Option<OutputState<'static>>,
+    pub t1: Option<Simulation>,
+}
+
+/// `sim` (freshly built from `case`) with the saved engine state `e`, after checking that
+/// every index the engine will follow is in range.
+fn apply(
+    e: EngineState,
+    mut sim: Simulation,
+    case: &Case,
+    bad: &dyn Fn(String) -> CheckpointError,
+) -> Result<Simulation, CheckpointError> {
+    let n = sim.particles.len();
+    e.particles.check(n).map_err(&bad)?;
+    // sizes and masses are the case's (the inserted set has them by id); the state is
+    // finite and inside the drum, as the engine keeps it
+    let inserted = &sim.particles;
+    let p = &e.particles;
+    for i in 0..n {
+        let id = p.id[i] as usize;
+        let finite = [p.pos[i], p.vel[i], p.omega[i], p.force[i], p.torque[i]]
+            .iter()
+            .flatten()
+            .chain([&p.temp[i], &p.heat_flow[i]])
+            .all(|x| x.is_finite());
+        if p.radius[i] != inserted.radius[id] || p.mass[i] != inserted.mass[id] || !finite {
+            return Err(bad(format!(
+                    "particle {id} (slot {i}): radius {} m, mass {} kg, or a non-finite state value; the case gives {} m, {} kg",
+                    p.radius[i], p.mass[i], inserted.radius[id], inserted.mass[id]
+                )));
+        }
+    }
+    e.neighbors
+        .check(n, sim.pipeline.grid.layers(), sim.walls.len())
+        .map_err(&bad)?;
+    if e.neighbors.skin != sim.neighbors.skin {
+        return Err(bad(format!(
+            "Verlet skin {} m, the case gives {} m",
+            e.neighbors.skin, sim.neighbors.skin
+        )));
+    }
+    if !e.groups.hot.is_empty() && e.groups.hot.len() != n {
+        return Err(bad(format!(
+            "{} group flags for {n} particles",
+            e.groups.hot.len()
+        )));
+    }
+    if e.time != e.step as f64 * case.time.dt {
+        return Err(bad(format!(
+            "t = {} s is not step {} × dt = {} s",
+            e.time, e.step, case.time.dt
+        )));
+    }
+    sim.particles = e.particles.into_owned();
+    sim.neighbors = e.neighbors.into_owned();
+    sim.walls.angular_velocity = e.angular_velocity;
+    sim.walls.mantle_temperature = e.mantle_temperature;
+    sim.groups = e.groups.into_owned();
+    sim.time = e.time;
+    sim.step = e.step;
+    sim.last_contacts = e.last_contacts;
+    sim.counters = e.counters.into_owned();
+    sim.check_inside().map_err(|e| bad(e.to_string()))?;
+    Ok(sim)
 }

@@ -1,7 +1,9 @@
 //! `tdex record` as a library call: run the case to `t0`, assign the temperatures, record one
 //! period `τ` (sampled table + snapshots at `t0` and `t1`) and, optionally, K reference periods.
 
-use super::checkpoint::{Checkpoint, CheckpointError, Elapsed, EngineState, OutputState, Stage};
+use super::checkpoint::{
+    Checkpoint, CheckpointError, Elapsed, EngineState, OutputState, Restored, Stage,
+};
 use super::journal::{JournalError, JournalMark, RowJournal};
 use super::{CollisionRow, ContactSampler};
 use crate::case::Case;
@@ -29,6 +31,9 @@ pub struct RecordOptions {
     pub period_steps: u64,
     /// Reference periods after `t1`.
     pub reference_periods: u32,
+    /// DEM twins: further runs continued from the state at `t1` over the reference periods,
+    /// twin `m` with the drum's angular velocity changed by `m` units in the last place.
+    pub twins: u32,
     pub area_encoding: AreaEncoding,
 }
 
@@ -39,6 +44,8 @@ pub enum Phase {
     SpinUp,
     Period,
     Reference,
+    /// The reference periods of DEM twin `m` (1-based), continued from `t1`.
+    Twin(u32),
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -182,6 +189,15 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
         return Err(RecordError::Settings(format!(
             "τ = {} steps must be a positive multiple of n = {every}",
             opts.period_steps
+        )));
+    }
+    if opts.twins > crate::format::MAX_TWINS || (opts.twins > 0 && opts.reference_periods == 0) {
+        return Err(RecordError::Settings(format!(
+            "{} DEM twins with {} reference periods: twins run over the reference periods, so \
+             they need at least one, and at most {} twins are recorded",
+            opts.twins,
+            opts.reference_periods,
+            crate::format::MAX_TWINS
         )));
     }
     ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
@@ -341,6 +357,13 @@ fn describe(stage: Stage, run: &RecordRun) -> String {
             o.reference_periods,
             o.period_steps
         ),
+        Stage::Twin { twin, period, done } => format!(
+            "twin {twin} of {} reference period {} of {} step {done} of {}",
+            o.twins,
+            period + 1,
+            o.reference_periods,
+            o.period_steps
+        ),
     }
 }
 
@@ -369,8 +392,37 @@ fn run_phase(
     Ok(())
 }
 
-/// The state a run resumes from.
-type Restored = (Simulation, Stage, Elapsed, Option<OutputState<'static>>);
+/// DEM twin `twin` (1-based) of the run standing at `t1`: the same state with the drum's
+/// angular velocity changed by `twin` units in the last place. Granular flow is chaotic, so
+/// this round-off change parts the twin from the DEM by particle diameters within a period
+/// while leaving every law and setting the same: the twin is one more DEM run of the case.
+pub fn twin_of(at_t1: &Simulation, twin: u32) -> Simulation {
+    let mut sim = at_t1.clone();
+    let omega = sim.walls.angular_velocity;
+    sim.walls.angular_velocity = f64::from_bits(omega.to_bits() + twin as u64);
+    sim
+}
+
+/// A twin that left the run bit for bit unchanged measures no spread: refused.
+fn check_twin_differs(
+    twin: u32,
+    snapshot: &Snapshot,
+    dem: Option<&Snapshot>,
+) -> Result<(), RecordError> {
+    let Some(dem) = dem else {
+        return Ok(());
+    };
+    if dem.pos == snapshot.pos && dem.temp == snapshot.temp {
+        return Err(RecordError::Settings(format!(
+            "DEM twin {twin}: the drum's angular velocity changed by {twin} unit(s) in the last \
+             place left the run identical to the DEM at t{}, bit for bit; a twin \
+             that does not differ measures no spread (a drum that does not turn cannot be \
+             perturbed this way): record without --twins",
+            snapshot.index
+        )));
+    }
+    Ok(())
+}
 
 /// The whole run from wherever it stands: settle, spin-up, the recorded period, the
 /// reference periods, with checkpoints when `saver` is given.
@@ -382,12 +434,13 @@ fn drive(
 ) -> Result<RecordingSummary, RecordError> {
     let fresh_sampler = check(run.options)?;
     let (case, opts) = (run.case, run.options);
-    let (mut sim, mut stage, mut elapsed, output) = match restored {
-        Some(r) => r,
+    let (mut sim, mut stage, mut elapsed, output, mut at_t1) = match restored {
+        Some(r) => (r.sim, r.stage, r.elapsed, r.output, r.t1),
         None => (
             Simulation::new(case)?,
             Stage::Settle { done: 0 },
             Elapsed::default(),
+            None,
             None,
         ),
     };
@@ -439,8 +492,16 @@ fn drive(
             let journal = RowJournal::resume(path, out.journal, &mut |rows| {
                 Ok(writer.push_rows(rows.iter().copied())?)
             })?;
-            for snapshot in &out.snapshots[1..] {
-                writer.write_snapshot(snapshot)?;
+            // the run's own snapshots, then each twin's, in the order they were written
+            let own = 2 + opts.reference_periods as usize;
+            for (k, snapshot) in out.snapshots.iter().enumerate().skip(1) {
+                match k.checked_sub(own) {
+                    None => writer.write_snapshot(snapshot)?,
+                    Some(past) => writer.write_twin_snapshot(
+                        1 + (past / opts.reference_periods as usize) as u32,
+                        snapshot,
+                    )?,
+                }
             }
             let sink = RowSink {
                 writer,
@@ -486,6 +547,9 @@ fn drive(
         let t = Instant::now();
         let t1 = sim.snapshot(1);
         sink.writer.write_snapshot(&t1)?;
+        if opts.twins > 0 {
+            at_t1 = Some(sim.clone());
+        }
         // kept only for the checkpoints: a snapshot is 68 B a particle
         if saver.is_some() {
             snapshots.push(t1);
@@ -495,56 +559,92 @@ fn drive(
         stage = Stage::Reference { period: 0, done: 0 };
     }
 
-    // the reference periods
-    if let Stage::Reference {
-        period: first,
-        done,
-    } = stage
-    {
-        let mark = match &mut sink.journal {
-            Some(j) => Some(j.sync()?),
-            None => None,
+    // the reference periods, then the DEM twins, each from t1 over the same periods (the
+    // run's own t2 is kept to check that the twins differ from it)
+    let mut dem_t2: Option<Snapshot> = None;
+    let mut main_stage_seconds = None;
+    if matches!(stage, Stage::Reference { .. } | Stage::Twin { .. }) {
+        let mut past_t1 = PastT1 {
+            run,
+            saver: saver.as_mut(),
+            mark: match &mut sink.journal {
+                Some(j) => Some(j.sync()?),
+                None => None,
+            },
+            run_at_t0: &run_at_t0,
+            sampler: &sampler,
+            at_t1: at_t1.as_ref(),
+            elapsed,
+            began: Instant::now(),
         };
-        let (began, base) = (Instant::now(), elapsed.reference);
-        let reference_steps = opts.reference_periods as u64 * opts.period_steps;
-        for period in first..opts.reference_periods {
-            let start = if period == first { done } else { 0 };
-            let offset = period as u64 * opts.period_steps;
-            run_phase(
+        if let Stage::Reference {
+            period: first,
+            done,
+        } = stage
+        {
+            past_t1.periods(
                 &mut sim,
-                start,
-                opts.period_steps,
-                &mut |d| progress(Phase::Reference, offset + d, reference_steps),
-                &mut |sim, done| match (&mut saver, mark) {
-                    (Some(s), Some(journal)) if s.due() => {
-                        let output = OutputState {
-                            run: run_at_t0.clone(),
-                            snapshots: Cow::Borrowed(&snapshots),
-                            sampler: Cow::Borrowed(&sampler),
-                            journal,
-                        };
-                        let elapsed = Elapsed {
-                            reference: base + began.elapsed().as_secs_f64(),
-                            ..elapsed
-                        };
-                        s.save(
-                            run,
-                            sim,
-                            Stage::Reference { period, done },
-                            elapsed,
-                            Some(output),
-                        )
+                Continuation::Reference,
+                (first, done),
+                &mut snapshots,
+                progress,
+                &mut |period, snapshot| {
+                    sink.writer.write_snapshot(snapshot)?;
+                    if period == 0 && opts.twins > 0 {
+                        dem_t2 = Some(snapshot.clone());
                     }
-                    _ => Ok(()),
+                    Ok(())
                 },
             )?;
-            let snapshot = sim.snapshot(period + 2);
-            sink.writer.write_snapshot(&snapshot)?;
-            if saver.is_some() {
-                snapshots.push(snapshot);
+            past_t1.stage_done(Continuation::Reference);
+            if let Some(t1) = &at_t1 {
+                main_stage_seconds = Some(stage_seconds(&sim));
+                sim = twin_of(t1, 1);
+                stage = Stage::Twin {
+                    twin: 1,
+                    period: 0,
+                    done: 0,
+                };
             }
         }
-        elapsed.reference = base + began.elapsed().as_secs_f64();
+        if let Stage::Twin {
+            twin: first,
+            period: first_period,
+            done,
+        } = stage
+        {
+            let t1 = at_t1.as_ref().ok_or_else(|| {
+                RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
+            })?;
+            if dem_t2.is_none() {
+                dem_t2 = snapshots.get(2).cloned();
+            }
+            for twin in first..=opts.twins {
+                if twin != first {
+                    sim = twin_of(t1, twin);
+                }
+                let from = if twin == first {
+                    (first_period, done)
+                } else {
+                    (0, 0)
+                };
+                past_t1.periods(
+                    &mut sim,
+                    Continuation::Twin(twin),
+                    from,
+                    &mut snapshots,
+                    progress,
+                    &mut |period, snapshot| {
+                        if period == 0 {
+                            check_twin_differs(twin, snapshot, dem_t2.as_ref())?;
+                        }
+                        Ok(sink.writer.write_twin_snapshot(twin, snapshot)?)
+                    },
+                )?;
+            }
+            past_t1.stage_done(Continuation::Twin(first));
+        }
+        elapsed = past_t1.elapsed;
     }
 
     let costs = run.write_costs.then(|| RecordingCosts {
@@ -552,7 +652,10 @@ fn drive(
         seconds_period: elapsed.period,
         seconds_reference: elapsed.reference,
         seconds_recorder: elapsed.recorder,
-        stage_seconds: stage_seconds(&sim),
+        seconds_twins: elapsed.twins,
+        // the run's own stages; a run resumed among its twins has only the last twin's,
+        // which carry the run's up to t1
+        stage_seconds: main_stage_seconds.unwrap_or_else(|| stage_seconds(&sim)),
         threads: rayon::current_num_threads(),
     });
     let RowSink { writer, journal } = sink;
@@ -562,6 +665,122 @@ fn drive(
         s.remove();
     }
     Ok(summary)
+}
+
+/// A DEM run continued past `t1` over the reference periods: the run's own, or a twin's.
+#[derive(Debug, Clone, Copy)]
+enum Continuation {
+    Reference,
+    Twin(u32),
+}
+
+impl Continuation {
+    fn stage(self, period: u32, done: u64) -> Stage {
+        match self {
+            Continuation::Reference => Stage::Reference { period, done },
+            Continuation::Twin(twin) => Stage::Twin { twin, period, done },
+        }
+    }
+
+    fn phase(self) -> Phase {
+        match self {
+            Continuation::Reference => Phase::Reference,
+            Continuation::Twin(twin) => Phase::Twin(twin),
+        }
+    }
+}
+
+/// What the runs past `t1` need to checkpoint themselves: the output's state (fixed since
+/// `t1`), the state at `t1` while twins are to come, and the wall time of the stage.
+struct PastT1<'a> {
+    run: &'a RecordRun<'a>,
+    saver: Option<&'a mut Saver>,
+    mark: Option<JournalMark>,
+    run_at_t0: &'a RunAtT0,
+    sampler: &'a ContactSampler,
+    at_t1: Option<&'a Simulation>,
+    /// Elapsed times when the stage (re)started.
+    elapsed: Elapsed,
+    began: Instant,
+}
+
+impl PastT1<'_> {
+    /// The elapsed times with the stage of `which` counted to now.
+    fn elapsed_now(&self, which: Continuation) -> Elapsed {
+        let now = self.began.elapsed().as_secs_f64();
+        match which {
+            Continuation::Reference => Elapsed {
+                reference: self.elapsed.reference + now,
+                ..self.elapsed
+            },
+            Continuation::Twin(_) => Elapsed {
+                twins: self.elapsed.twins + now,
+                ..self.elapsed
+            },
+        }
+    }
+
+    /// The stage of `which` is over: its wall time is counted, the next stage's starts now.
+    fn stage_done(&mut self, which: Continuation) {
+        self.elapsed = self.elapsed_now(which);
+        self.began = Instant::now();
+    }
+
+    /// Runs the reference periods of `which` from `(period, done)` on, offering checkpoints
+    /// between blocks of steps; each period's snapshot goes to `stored` (its index is
+    /// `period + 2`) and, when the run is checkpointed, into `snapshots`.
+    fn periods(
+        &mut self,
+        sim: &mut Simulation,
+        which: Continuation,
+        (first, done): (u32, u64),
+        snapshots: &mut Vec<Snapshot>,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+        stored: &mut dyn FnMut(u32, &Snapshot) -> Result<(), RecordError>,
+    ) -> Result<(), RecordError> {
+        let opts = self.run.options;
+        let total = opts.reference_periods as u64 * opts.period_steps;
+        for period in first..opts.reference_periods {
+            let start = if period == first { done } else { 0 };
+            let offset = period as u64 * opts.period_steps;
+            run_phase(
+                sim,
+                start,
+                opts.period_steps,
+                &mut |d| progress(which.phase(), offset + d, total),
+                &mut |sim, done| {
+                    let elapsed = self.elapsed_now(which);
+                    let (Some(saver), Some(journal)) = (self.saver.as_deref_mut(), self.mark)
+                    else {
+                        return Ok(());
+                    };
+                    if !saver.due() {
+                        return Ok(());
+                    }
+                    let output = OutputState {
+                        run: self.run_at_t0.clone(),
+                        snapshots: Cow::Borrowed(snapshots),
+                        sampler: Cow::Borrowed(self.sampler),
+                        journal,
+                        t1_engine: self.at_t1.map(EngineState::of),
+                    };
+                    saver.save(
+                        self.run,
+                        sim,
+                        which.stage(period, done),
+                        elapsed,
+                        Some(output),
+                    )
+                },
+            )?;
+            let snapshot = sim.snapshot(period + 2);
+            stored(period, &snapshot)?;
+            if self.saver.is_some() {
+                snapshots.push(snapshot);
+            }
+        }
+        Ok(())
+    }
 }
 
 fn stage_seconds(sim: &Simulation) -> std::collections::BTreeMap<String, f64> {
@@ -608,6 +827,7 @@ impl PeriodCheckpoint for PeriodSaver<'_> {
             snapshots: Cow::Borrowed(std::slice::from_ref(self.t0)),
             sampler: Cow::Borrowed(sampler),
             journal: *journal,
+            t1_engine: None,
         };
         let elapsed = Elapsed {
             period: self.elapsed.period + self.began.elapsed().as_secs_f64(),
@@ -670,6 +890,13 @@ pub fn record_many_from_t0(
     }) {
         return Err(RecordError::Settings(
             "the recordings of one run must share τ and the reference periods".into(),
+        ));
+    }
+    if jobs.iter().any(|j| j.options.twins > 0) {
+        return Err(RecordError::Settings(
+            "DEM twins are recorded by a single recording (tdex record --twins), not by a \
+             sweep of samplings"
+                .into(),
         ));
     }
     let samplers = jobs
@@ -738,6 +965,7 @@ pub fn record_many_from_t0(
                 seconds_period,
                 seconds_reference,
                 seconds_recorder,
+                seconds_twins: 0.0,
                 stage_seconds: stage_seconds.clone(),
                 threads: rayon::current_num_threads(),
             };
@@ -981,6 +1209,7 @@ pub(crate) fn recording_info(
         t0: run.t0,
         step_t0: run.step_t0,
         reference_periods: opts.reference_periods,
+        twins: opts.twins,
         area_encoding: opts.area_encoding,
         sqrt_area_unit: match opts.area_encoding {
             AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * run.r_max / SQRT_AREA_CODES,

@@ -1,0 +1,154 @@
+//! The DEM's own spread at one `t_k` (the "floor"): the cell distances between the DEM runs
+//! of one case (the reference and its twins), and the extrapolation's distance to those runs
+//! measured the same way, so that the extrapolation is judged as one more run would be.
+
+use super::metrics::{eps_abs, Cells};
+use serde::Serialize;
+
+/// The DEM runs' spread and the extrapolation's place in it, at one `t_k`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Floor {
+    /// Mean `ε_abs` (K) over the pairs of DEM runs.
+    pub floor_eps_abs: f64,
+    /// Smallest and largest `ε_abs` (K) of a pair of DEM runs.
+    pub floor_eps_abs_min: f64,
+    pub floor_eps_abs_max: f64,
+    /// Pairs of DEM runs measured.
+    pub floor_pairs: usize,
+    /// The extrapolation's mean `ε_abs` (K) to the DEM runs.
+    pub eps_abs_to_dem_runs: f64,
+    /// `eps_abs_to_dem_runs / floor_eps_abs`; absent when the DEM runs are identical
+    /// (floor 0): nothing to judge against, not an infinite ratio.
+    pub ratio_to_floor: Option<f64>,
+}
+
+impl Floor {
+    /// Whether the extrapolation is within the DEM runs' own range at this `t_k`: no farther
+    /// from them on average than the two farthest runs are from each other.
+    pub fn within_range(&self) -> bool {
+        self.eps_abs_to_dem_runs <= self.floor_eps_abs_max
+    }
+}
+
+/// The cell means of one field: positions and temperatures in the same order.
+pub struct Field<'a> {
+    pub pos: &'a [[f64; 3]],
+    pub temp: &'a [f64],
+}
+
+/// The floor of `runs` (at least two DEM runs at the same `t_k`) and the distance of
+/// `second` (cell means already computed) to them, on `cells`. `None` with fewer than two
+/// runs or when no cell holds particles of both fields of some pair.
+pub fn floor(cells: &Cells, runs: &[Field], second: &[Option<f64>]) -> Option<Floor> {
+    if runs.len() < 2 {
+        return None;
+    }
+    let means: Vec<Vec<Option<f64>>> = runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
+    let mut pairs = Vec::new();
+    for (i, a) in means.iter().enumerate() {
+        for b in &means[i + 1..] {
+            pairs.push(eps_abs(a, b)?.0);
+        }
+    }
+    let to_runs = means
+        .iter()
+        .map(|m| eps_abs(m, second).map(|(e, _)| e))
+        .collect::<Option<Vec<f64>>>()?;
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    let floor_eps_abs = mean(&pairs);
+    let eps_abs_to_dem_runs = mean(&to_runs);
+    Some(Floor {
+        floor_eps_abs,
+        floor_eps_abs_min: pairs.iter().copied().fold(f64::INFINITY, f64::min),
+        floor_eps_abs_max: pairs.iter().copied().fold(0.0, f64::max),
+        floor_pairs: pairs.len(),
+        eps_abs_to_dem_runs,
+        ratio_to_floor: (floor_eps_abs > 0.0).then(|| eps_abs_to_dem_runs / floor_eps_abs),
+    })
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `None` if empty.
+pub fn median(values: &[f64]) -> Option<f64> {
+    let mut v = values.to_vec();
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    match n {
+        0 => None,
+        _ if n % 2 == 1 => Some(v[n / 2]),
+        _ => Some(0.5 * (v[n / 2 - 1] + v[n / 2])),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cells() -> Cells {
+        Cells::from_seeds(vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    }
+
+    const POS: [[f64; 3]; 4] = [
+        [-0.5, 0.0, 0.0],
+        [-1.5, 0.0, 0.0],
+        [0.5, 0.0, 0.0],
+        [1.5, 0.0, 0.0],
+    ];
+
+    #[test]
+    fn a_twin_identical_to_the_dem_gives_floor_zero_and_no_ratio() {
+        let temp = [10.0, 20.0, 30.0, 40.0];
+        let dem = Field {
+            pos: &POS,
+            temp: &temp,
+        };
+        let twin = Field {
+            pos: &POS,
+            temp: &temp,
+        };
+        let extra = [Some(16.0), Some(35.0)];
+        let f = floor(&cells(), &[dem, twin], &extra).unwrap();
+        assert_eq!(f.floor_eps_abs, 0.0);
+        assert_eq!(f.floor_eps_abs_max, 0.0);
+        assert_eq!(f.eps_abs_to_dem_runs, 0.5);
+        // absent, not infinite: a floor of 0 gives nothing to divide by
+        assert_eq!(f.ratio_to_floor, None);
+        assert!(!f.within_range());
+    }
+
+    #[test]
+    fn the_floor_is_the_runs_distance_and_the_ratio_the_extrapolations_over_it() {
+        let (t_dem, t_twin) = ([10.0, 20.0, 30.0, 40.0], [12.0, 22.0, 30.0, 40.0]);
+        // cell means: DEM (15, 35), twin (17, 35): they differ by 1 K on average
+        let runs = [
+            Field {
+                pos: &POS,
+                temp: &t_dem,
+            },
+            Field {
+                pos: &POS,
+                temp: &t_twin,
+            },
+        ];
+        // the extrapolation halfway between them: 0.5 K from each
+        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)]).unwrap();
+        assert_eq!(f.floor_eps_abs, 1.0);
+        assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
+        assert_eq!(f.eps_abs_to_dem_runs, 0.5);
+        assert_eq!(f.ratio_to_floor, Some(0.5));
+        assert!(f.within_range());
+        // a field 3 K off in the first cell is farther than the runs are from each other
+        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)]).unwrap();
+        assert_eq!(far.eps_abs_to_dem_runs, 1.5);
+        assert_eq!(far.ratio_to_floor, Some(1.5));
+        assert!(!far.within_range());
+        // one run alone has no floor
+        assert_eq!(floor(&cells(), &runs[..1], &[Some(15.0), Some(35.0)]), None);
+    }
+
+    #[test]
+    fn the_median_of_an_even_count_is_the_mean_of_the_middle_two() {
+        assert_eq!(median(&[]), None);
+        assert_eq!(median(&[3.0, 1.0, 2.0]), Some(2.0));
+        assert_eq!(median(&[4.0, 1.0, 3.0, 2.0]), Some(2.5));
+    }
+}

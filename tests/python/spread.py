@@ -1,0 +1,46 @@
+#!/usr/bin/env python3
+"""How unmixed is the bed at the particle scale? (diagnostic, docs/validation.md)
+
+usage: spread.py RECORDING.mcap EXTRA.mcap   (RECORDING made with --reference K --twins M)
+
+Prints, at every t_k the extrapolation holds, the standard deviation of the particle
+temperatures (K) of the DEM reference, of each DEM twin and of the extrapolation, and the
+extrapolation's over the DEM runs' mean: where it grows above 1, the replay leaves
+particle-scale temperature differences that the DEM has already mixed away.
+"""
+import sys
+
+import numpy as np
+from mcap.reader import make_reader
+from mcap_protobuf.decoder import DecoderFactory
+
+from period_map import POINT
+
+
+def by_topic(path):
+    out = {}
+    with open(path, "rb") as f:
+        reader = make_reader(f, decoder_factories=[DecoderFactory()])
+        for _, channel, message, cloud in reader.iter_decoded_messages():
+            if channel.topic == "/tdex/snapshots" or channel.topic.startswith("/tdex/twins/"):
+                out.setdefault(channel.topic, {})[message.sequence] = np.frombuffer(
+                    cloud.data, dtype=POINT)
+    return out
+
+
+def main(recording, extra):
+    runs = by_topic(recording)
+    dem = runs.pop("/tdex/snapshots")
+    twins = [runs[t] for t in sorted(runs)]
+    ex = by_topic(extra)["/tdex/snapshots"]
+    for k in sorted(ex):
+        if k not in dem:
+            continue
+        stds = [dem[k]["T"].std()] + [t[k]["T"].std() for t in twins if k in t]
+        e = ex[k]["T"].std()
+        print(f"t_{k}: std DEM runs " + ", ".join(f"{s:.4f}" for s in stds)
+              + f" K, extrapolated {e:.4f} K, ratio {e / np.mean(stds):.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2])
