@@ -11,7 +11,7 @@ pub use checkpoint::{Checkpoint, CheckpointError, Stage};
 pub use journal::JournalError;
 pub use recording::{
     checkpoint_path, journal_path, record, record_from_t0, record_many_from_t0, record_run, resume,
-    run_to_t0, Phase, RecordError, RecordJob, RecordOptions, RecordRun,
+    run_to_t0, twin_of, Phase, RecordError, RecordJob, RecordOptions, RecordRun,
 };
 pub use sampler::ContactSampler;
 
