@@ -486,7 +486,19 @@ fn largest_divisor_up_to(m: u64, limit: u64) -> u64 {
 fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Result<()> {
     let info = reader.info();
     let ri = &info.recording_info;
-    let snapshots = reader.snapshots()?;
+    // each snapshot's own radii: point j is role j, with the radius of the particle there
+    let total_heat = |s: &Snapshot| replay::total_heat(&s.temp, &Bodies::of(ri, s));
+    // streamed: one snapshot in memory at a time, whatever the number of periods
+    let mut snapshots = Vec::new();
+    for s in reader.snapshots_in_order() {
+        let s = s?;
+        snapshots.push(ExtrapolatedSnapshot {
+            index: s.index,
+            time: s.time,
+            mean_temperature: mean_temperature(&s),
+            total_heat: total_heat(&s),
+        });
+    }
     let (Some(first), Some(last)) = (snapshots.first(), snapshots.last()) else {
         return Err(FormatError::Corrupt {
             path: plan.file.clone(),
@@ -494,9 +506,7 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         }
         .into());
     };
-    // each snapshot's own radii: point j is role j, with the radius of the particle there
-    let total_heat = |s: &Snapshot| replay::total_heat(&s.temp, &Bodies::of(ri, s));
-    let (start, end) = (total_heat(first), total_heat(last));
+    let (start, end) = (first.total_heat, last.total_heat);
     let conducting_walls = conducting_walls(ri);
     let inspection = ExtrapolationInspection {
         kind: "extrapolation",
@@ -515,18 +525,10 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,
-        mean_temperature_start: mean_temperature(first),
-        mean_temperature_end: mean_temperature(last),
+        mean_temperature_start: first.mean_temperature,
+        mean_temperature_end: last.mean_temperature,
         wall_heat: (conducting_walls > 0).then_some(end - start),
-        snapshots: snapshots
-            .iter()
-            .map(|s| ExtrapolatedSnapshot {
-                index: s.index,
-                time: s.time,
-                mean_temperature: mean_temperature(s),
-                total_heat: total_heat(s),
-            })
-            .collect(),
+        snapshots,
         costs: reader.costs().cloned(),
     };
     emit(plan.json, &inspection, print_extrapolation)

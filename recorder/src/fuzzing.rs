@@ -19,13 +19,14 @@ pub const DUMP_PERIOD: u64 = 15;
 pub const DUMP_PARTICLES: u64 = 250;
 
 /// Opens `bytes` as a recording and reads everything a tdex command reads of one: its info,
-/// summary, costs and sizes, every snapshot (all, and `t0` and `t1` alone) and the whole
-/// table.
+/// summary, costs and sizes, every snapshot (all, and `t0` and `t1` alone, and the DEM
+/// twins') and the whole table.
 pub fn recording(bytes: &[u8]) -> Result<(), FormatError> {
     let reader = RecordingReader::from_bytes(Path::new(MCAP_NAME), bytes.to_vec())?;
     let _ = (reader.info(), reader.summary(), reader.costs());
     let _ = (reader.file_bytes(), reader.table_bytes());
     reader.snapshots()?;
+    reader.twin_snapshots()?;
     reader.snapshot(0)?;
     reader.snapshot(1)?;
     for batch in reader.table() {
@@ -34,11 +35,15 @@ pub fn recording(bytes: &[u8]) -> Result<(), FormatError> {
     Ok(())
 }
 
-/// Opens `bytes` as an extrapolation and reads its info, costs and every snapshot.
+/// Opens `bytes` as an extrapolation and reads its info, costs and every snapshot (at once
+/// and streamed).
 pub fn extrapolation(bytes: &[u8]) -> Result<(), FormatError> {
     let reader = ExtrapolationReader::from_bytes(Path::new(MCAP_NAME), bytes.to_vec())?;
-    let _ = (reader.info(), reader.costs());
+    let _ = (reader.info(), reader.costs(), reader.snapshot_count());
     reader.snapshots()?;
+    for snapshot in reader.snapshots_in_order() {
+        snapshot?;
+    }
     Ok(())
 }
 

@@ -151,6 +151,9 @@ pub struct GroupMeans {
     pub bed: f64,
 }
 
+/// The second field's snapshots in index order, one at a time.
+type SnapshotStream<'a> = Box<dyn Iterator<Item = Result<Snapshot>> + 'a>;
+
 /// The initially hot and cold particles of a run (`None`: a uniform start).
 type HotCold = Option<(Vec<u32>, Vec<u32>)>;
 
@@ -256,7 +259,7 @@ pub fn compare_runs(
         check_same_instants((recording, &dem), (run, &snaps))?;
         others.push(snaps);
     }
-    let (extra_path, extra, kind) = match second {
+    let (extra_path, extra, kind, own_groups) = match second {
         Second::Extrapolation(extrapolation) => {
             let extra_path = extrapolation.path().display().to_string();
             if extrapolation.info().recording_info != *recording.info() {
@@ -266,16 +269,29 @@ pub fn compare_runs(
                     extrapolation.info().recording
                 );
             }
-            (
-                extra_path,
-                extrapolation.snapshots()?,
-                SecondKind::Extrapolation,
-            )
+            // streamed: an extrapolation of hundreds of periods is never held whole
+            let snaps: SnapshotStream = Box::new(
+                extrapolation
+                    .snapshots_in_order()
+                    .map(|s| s.map_err(anyhow::Error::from)),
+            );
+            (extra_path, snaps, SecondKind::Extrapolation, None)
         }
         Second::Dem(twin) => {
             let snaps = twin.snapshots()?;
             check_same_instants((recording, &dem), (twin, &snaps))?;
-            (twin.path().display().to_string(), snaps, SecondKind::Dem)
+            // its own hot and cold particles, chosen by the same rule at its own t0
+            let own_groups = snaps
+                .iter()
+                .find(|s| s.index == 0)
+                .and_then(|s| metrics::hot_cold_groups(&metrics::by_id(&s.id, &s.temp)));
+            let snaps: SnapshotStream = Box::new(snaps.into_iter().map(Ok));
+            (
+                twin.path().display().to_string(),
+                snaps,
+                SecondKind::Dem,
+                own_groups,
+            )
         }
     };
     let dem_at = |k: u32| dem.iter().find(|s| s.index == k);
@@ -300,10 +316,7 @@ pub fn compare_runs(
     // its own hot and cold particles, chosen by the same rule at its own t0.
     let extra_groups = match kind {
         SecondKind::Extrapolation => groups.clone(),
-        SecondKind::Dem => extra
-            .iter()
-            .find(|s| s.index == 0)
-            .and_then(|s| metrics::hot_cold_groups(&metrics::by_id(&s.id, &s.temp))),
+        SecondKind::Dem => own_groups,
     };
     let means_in = |groups: &Option<(Vec<u32>, Vec<u32>)>, temps_by_id: &[f64]| match groups {
         Some((hot, cold)) => (
@@ -356,8 +369,13 @@ pub fn compare_runs(
     let mut role_cells: Option<Vec<u32>> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
-    for pair in extra.windows(2) {
-        let (before, after) = (&pair[0], &pair[1]);
+    let mut previous: Option<Snapshot> = None;
+    for after in extra {
+        let after = after?;
+        let Some(before) = previous.replace(after.clone()) else {
+            continue;
+        };
+        let (before, after) = (&before, &after);
         let k = after.index;
         let (Some(dem_before), Some(dem_after)) = (dem_at(before.index), dem_at(k)) else {
             unreferenced.push(k);

@@ -127,14 +127,19 @@ pub fn write_with(
         .with_context(|| format!("{rec_path}: cannot read the snapshots"))?;
     let (i0, i1) = prediction::t0_t1(&dem, &rec_path)?;
     let measures = Measures::new(info, &dem[i0], &dem[i1], cells, seed);
-    let extra_snaps = extrapolation
-        .snapshots()
-        .with_context(|| format!("{extra_path}: cannot read the extrapolated snapshots"))?;
-    let extra_at = |k: u32| extra_snaps.iter().find(|s| s.index == k).cloned();
+    // the extrapolated snapshots are streamed: memory holds the few the plots draw
     let field_snap = comparison.and_then(|c| c.periods.last()).map(|last| last.k);
-    let field_extra = field_snap.and_then(extra_at);
-    let pred = Prediction::new(info, &measures, extra_snaps)
-        .with_context(|| format!("{extra_path}: nothing to report"))?;
+    let extra_snaps = extrapolation.snapshots_in_order().map(|s| {
+        s.with_context(|| format!("{extra_path}: cannot read the extrapolated snapshots"))
+    });
+    let (pred, field_extra) = Prediction::new(
+        info,
+        &measures,
+        extrapolation.snapshot_count(),
+        extra_snaps,
+        field_snap,
+    )
+    .with_context(|| format!("{extra_path}: nothing to report"))?;
     // the DEM's own spread and mixing where the recording has a reference: the reference,
     // then its twins
     let dem_points: Vec<Vec<prediction::Point>> = if comparison.is_some() {

@@ -211,32 +211,52 @@ pub struct Prediction {
 }
 
 impl Prediction {
-    /// Measures every snapshot of `snaps` (an extrapolation's, by index); keeps the first,
-    /// middle and last for the field plot.
-    pub fn new(info: &RecordingInfo, measures: &Measures, snaps: Vec<Snapshot>) -> Result<Self> {
-        let n = snaps.len();
-        anyhow::ensure!(n > 0, "the extrapolation holds no snapshot");
-        let keep = [0, n / 2, n - 1];
-        let capacity = measures.capacity(&snaps[0]);
-        let mut points = Vec::with_capacity(n);
-        let mut fields = Vec::new();
+    /// Measures every snapshot of `snaps` (an extrapolation's, streamed by index; `count`
+    /// of them, for the middle one) and keeps the first, middle and last for the field plot,
+    /// and the one with index `also` if asked: memory holds those and one point per snapshot,
+    /// whatever the number of periods.
+    pub fn new(
+        info: &RecordingInfo,
+        measures: &Measures,
+        count: usize,
+        snaps: impl IntoIterator<Item = Result<Snapshot>>,
+        also: Option<u32>,
+    ) -> Result<(Self, Option<Snapshot>)> {
+        let mut points = Vec::with_capacity(count);
+        let mut fields: Vec<Snapshot> = Vec::new();
+        let mut last: Option<Snapshot> = None;
+        let mut kept = None;
+        let mut capacity = None;
         for (i, s) in snaps.into_iter().enumerate() {
+            let s = s?;
             points.push(measures.point(&s));
-            if keep.contains(&i) && !fields.iter().any(|f: &Snapshot| f.index == s.index) {
-                fields.push(s);
+            capacity.get_or_insert_with(|| measures.capacity(&s));
+            if also == Some(s.index) {
+                kept = Some(s.clone());
             }
+            if i == 0 || i == count / 2 {
+                fields.push(s.clone());
+            }
+            last = Some(s);
+        }
+        let last = last.context("the extrapolation holds no snapshot")?;
+        if !fields.iter().any(|f| f.index == last.index) {
+            fields.push(last);
         }
         let (hot_particles, cold_particles) = measures.group_sizes();
-        Ok(Self {
-            points,
-            wall_temperature: info.walls.iter().find_map(|w| w.temperature),
-            hot_particles,
-            cold_particles,
-            lacey_cells: measures.lacey_cells(),
-            drum_radius: drum_radius(info),
-            capacity,
-            fields,
-        })
+        Ok((
+            Self {
+                points,
+                wall_temperature: info.walls.iter().find_map(|w| w.temperature),
+                hot_particles,
+                cold_particles,
+                lacey_cells: measures.lacey_cells(),
+                drum_radius: drum_radius(info),
+                capacity: capacity.unwrap_or_default(),
+                fields,
+            },
+            kept,
+        ))
     }
 
     pub fn first(&self) -> &Point {

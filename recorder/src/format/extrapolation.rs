@@ -172,29 +172,13 @@ impl ExtrapolationReader {
 
     /// All snapshots by index (1: the DEM state at `t1`, `k`: extrapolated `t_k`). Point
     /// `j` is role `j` (at the position of particle `j` at `t1`); its `id` is the physical
-    /// particle playing the role at that instant, so `id` is a permutation of `0..N`.
+    /// particle playing the role at that instant, so `id` is a permutation of `0..N`. Holds
+    /// every snapshot in memory: [`ExtrapolationReader::snapshots_in_order`] streams them.
     pub fn snapshots(&self) -> Result<Vec<Snapshot>, FormatError> {
-        let n = self.info.recording_info.particles as usize;
         let mut snaps = Vec::new();
         for m in self.file.messages_at(self.snapshot_channel, None) {
             let (index, data) = m?;
-            let snap = Snapshot::decode(index, &data).map_err(|e| self.file.corrupt(e))?;
-            if snap.len() != n {
-                return Err(self.file.corrupt(format!(
-                    "snapshot {index}: {} points for {n} particles",
-                    snap.len()
-                )));
-            }
-            let mut seen = vec![false; n];
-            for (j, &id) in snap.id.iter().enumerate() {
-                if id as usize >= n || std::mem::replace(&mut seen[id as usize], true) {
-                    return Err(self.file.corrupt(format!(
-                        "snapshot {index}: point {j} has id {id}, a repeat or out of 0..{n} \
-                         (ids must be a permutation)"
-                    )));
-                }
-            }
-            snaps.push(snap);
+            snaps.push(self.decode_checked(index, &data)?);
         }
         snaps.sort_by_key(|s| s.index);
         if let Some(w) = snaps.windows(2).find(|w| w[0].index == w[1].index) {
@@ -203,5 +187,58 @@ impl ExtrapolationReader {
                 .corrupt(format!("snapshot {} stored twice", w[0].index)));
         }
         Ok(snaps)
+    }
+
+    /// The snapshots one at a time in file order, which `tdex extrapolate` writes by index;
+    /// memory holds one chunk and one snapshot, whatever the number of periods. A snapshot
+    /// whose index does not follow the one before it is reported as damage.
+    pub fn snapshots_in_order(&self) -> impl Iterator<Item = Result<Snapshot, FormatError>> + '_ {
+        let mut last: Option<u32> = None;
+        self.file
+            .messages_at(self.snapshot_channel, None)
+            .map(move |m| {
+                let (index, data) = m?;
+                if last.is_some_and(|l| index <= l) {
+                    return Err(self.file.corrupt(format!(
+                        "snapshot {index} stored after snapshot {} (snapshots are stored by \
+                         increasing index)",
+                        last.unwrap_or_default()
+                    )));
+                }
+                last = Some(index);
+                self.decode_checked(index, &data)
+            })
+    }
+
+    /// Snapshots stored (from the file's statistics, nothing decoded).
+    pub fn snapshot_count(&self) -> usize {
+        self.file
+            .summary
+            .stats
+            .as_ref()
+            .and_then(|st| st.channel_message_counts.get(&self.snapshot_channel))
+            .map_or(0, |&n| n as usize)
+    }
+
+    /// Decodes a stored snapshot and checks it holds every particle once.
+    fn decode_checked(&self, index: u32, data: &[u8]) -> Result<Snapshot, FormatError> {
+        let n = self.info.recording_info.particles as usize;
+        let snap = Snapshot::decode(index, data).map_err(|e| self.file.corrupt(e))?;
+        if snap.len() != n {
+            return Err(self.file.corrupt(format!(
+                "snapshot {index}: {} points for {n} particles",
+                snap.len()
+            )));
+        }
+        let mut seen = vec![false; n];
+        for (j, &id) in snap.id.iter().enumerate() {
+            if id as usize >= n || std::mem::replace(&mut seen[id as usize], true) {
+                return Err(self.file.corrupt(format!(
+                    "snapshot {index}: point {j} has id {id}, a repeat or out of 0..{n} \
+                     (ids must be a permutation)"
+                )));
+            }
+        }
+        Ok(snap)
     }
 }
