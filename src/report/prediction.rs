@@ -372,12 +372,11 @@ mod tests {
             ..snap(0, [300.0, 300.0])
         };
         let m = Measures::new(&info, &t0, &t0, 200, 1);
-        let p = Prediction::new(
-            &info,
-            &m,
-            vec![snap(1, [300.0, 300.0]), snap(2, [310.0, 301.0])],
-        )
-        .unwrap();
+        let snaps = vec![snap(1, [300.0, 300.0]), snap(2, [310.0, 301.0])];
+        let (p, kept) = Prediction::new(&info, &m, 2, snaps.into_iter().map(Ok), Some(2)).unwrap();
+        // the snapshot asked for is kept, and the field plot has the first and the last
+        assert_eq!(kept.map(|s| s.index), Some(2));
+        assert_eq!(p.fields.iter().map(|s| s.index).collect::<Vec<_>>(), [1, 2]);
         assert_eq!(p.drum_radius, Some(0.05));
         assert!(!p.has_groups());
         let c = |r: f64| 1000.0 * 4.0 / 3.0 * std::f64::consts::PI * r * r * r;
