@@ -12,6 +12,9 @@
 //! data. `TDEX_REPEAT` (default 3) runs, certified, 2 threads (`TDEX_THREADS`); all runs
 //! must give the same result, which `TDEX_DUMP_G=file` writes out (g, one index a line).
 //!
+//! `TDEX_STRETCH=A:L` displaces the recording's t1 along y by A·d·sin(2π y / (L·d)), a
+//! stand-in for the axial transport of a long drum.
+//!
 //! Two t1 snapshots against the same t0 packing:
 //! * `independent`: a second packing of the same region generated independently (other
 //!   lattice orientation and offset, other jitter): no correlation at all, the worst case;
@@ -115,7 +118,19 @@ fn recording(path: &str, threads: usize) {
     let tile = env_usize("TDEX_TILE", 1);
     let repeat = env_usize("TDEX_REPEAT", 3);
     let t = Instant::now();
-    let (x0, x1, d) = load_recording(path, tile);
+    let (x0, mut x1, d) = load_recording(path, tile);
+    // `TDEX_STRETCH=A:L`: a stand-in for the axial mass transport of a long drum. t1 is
+    // displaced along y by `A·d·sin(2π (y − y_min) / (L·d))`, a density modulation of
+    // wavelength L diameters that the pairing must undo by shifting whole slabs.
+    if let Ok(spec) = std::env::var("TDEX_STRETCH") {
+        let (a, l) = spec.split_once(':').expect("TDEX_STRETCH=A:L");
+        let (a, l): (f64, f64) = (a.parse().unwrap(), l.parse().unwrap());
+        let ymin = x1.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min);
+        for p in &mut x1 {
+            p[1] += a * d * (std::f64::consts::TAU * (p[1] - ymin) / (l * d)).sin();
+        }
+        println!("t1 stretched along y: amplitude {a} d, wavelength {l} d");
+    }
     println!(
         "recording {path}: {} particles ({tile} × {}), d = {d:.6} m, read in {:.2} s; \
          {threads} threads",

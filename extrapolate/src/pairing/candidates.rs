@@ -29,6 +29,7 @@ pub(crate) fn knn(
     tree: &Tree,
     x0: &[[f64; 3]],
     x1: &[[f64; 3]],
+    centres: &[[f64; 3]],
     k: usize,
     scale: &CostScale,
 ) -> (Vec<u32>, Vec<i64>) {
@@ -45,7 +46,7 @@ pub(crate) fn knn(
         .with_min_len(256)
         .for_each(|(p, (cc, cs))| {
             let found = tree
-                .query(&x1[p])
+                .query(&centres[p])
                 .nearest_n::<SquaredEuclidean<f64>>(kk)
                 .execute();
             let mut row: Vec<(i64, u32)> = found
@@ -60,6 +61,119 @@ pub(crate) fn knn(
             }
         });
     (cols, costs)
+}
+
+/// Half-width, in ranks, of the window over which the axial transport estimate of
+/// [`Axial`] is averaged.
+const AXIAL_WINDOW: usize = 64;
+
+/// The one-dimensional transport along the bed's long axis, an estimate of the
+/// large-scale part of the pairing (docs/pairing.md, "Long drums").
+///
+/// In a long drum the particles drift along the axis, and the count of particles on
+/// either side of a cross-section differs between t0 and t1 by hundreds: the optimal
+/// pairing then shifts whole slabs of the bed by a diameter or more along the axis.
+/// A t1 point's optimal partner then often lies outside its k nearest t0 points (the
+/// kNN graph may even lose its perfect matching), and both the auction and the
+/// shortest augmenting paths have to carry the surplus along the whole bed. The
+/// monotone map between the two marginals along the axis (rank r of t1 to rank r of
+/// t0) is that transport in one dimension; its displacement `δ` (t1 → t0), averaged
+/// over `2·AXIAL_WINDOW + 1` ranks, gives the kNN query centres and warm-start
+/// potentials. Neither changes the problem: costs stay those of the true pairs, the
+/// solver accepts any starting potentials `<= 0`, and the certificate proves the
+/// result against every pair as before. Deterministic: the sorts break ties by index.
+pub(crate) struct Axial {
+    axis: usize,
+    /// t0 and t1 indices sorted along the axis.
+    s0: Vec<u32>,
+    s1: Vec<u32>,
+    /// Smoothed displacement t1 → t0 along the axis, by rank.
+    delta: Vec<f64>,
+}
+
+impl Axial {
+    pub(crate) fn new(x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
+        let n = x1.len();
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for p in x0.iter().chain(x1) {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        let axis = (0..3)
+            .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
+            .expect("three axes");
+        let sorted = |x: &[[f64; 3]]| {
+            let mut idx: Vec<u32> = (0..x.len() as u32).collect();
+            idx.sort_unstable_by(|&i, &j| {
+                x[i as usize][axis]
+                    .total_cmp(&x[j as usize][axis])
+                    .then(i.cmp(&j))
+            });
+            idx
+        };
+        let (s0, s1) = (sorted(x0), sorted(x1));
+        // Prefix sums of the displacement by rank, then a centred moving average.
+        let mut prefix = vec![0.0f64; n + 1];
+        for r in 0..n {
+            prefix[r + 1] = prefix[r] + (x0[s0[r] as usize][axis] - x1[s1[r] as usize][axis]);
+        }
+        let delta = (0..n)
+            .map(|r| {
+                let (a, b) = (
+                    r.saturating_sub(AXIAL_WINDOW),
+                    (r + AXIAL_WINDOW + 1).min(n),
+                );
+                (prefix[b] - prefix[a]) / (b - a) as f64
+            })
+            .collect();
+        Self {
+            axis,
+            s0,
+            s1,
+            delta,
+        }
+    }
+
+    /// Mean |δ|, in the units of the coordinates.
+    pub(crate) fn mean_abs_shift(&self) -> f64 {
+        self.delta.iter().map(|d| d.abs()).sum::<f64>() / self.delta.len().max(1) as f64
+    }
+
+    /// kNN query centres: every t1 point moved along the axis by `δ` at its rank.
+    pub(crate) fn centres(&self, x1: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let mut c = x1.to_vec();
+        for (r, &p) in self.s1.iter().enumerate() {
+            c[p as usize][self.axis] += self.delta[r];
+        }
+        c
+    }
+
+    /// Warm-start column potentials `v = −(Φ − min Φ) / unit` (integers, `max v = 0`),
+    /// with `Φ' = −δ / sqrt(ρ² + δ²)` along the t0 points in axis order (δ at the same
+    /// rank). A row p whose partner lies `δ` further along the axis at a lateral
+    /// distance ρ then finds its smallest `c − v` there: the derivative of
+    /// `sqrt(ρ² + (y − y_p)²) + Φ(y)` vanishes at `y − y_p = δ`. `rho` is the typical
+    /// pair distance (the mean cheapest candidate cost).
+    pub(crate) fn potentials(&self, x0: &[[f64; 3]], rho: f64, unit: f64) -> Vec<i64> {
+        let n = x0.len();
+        let mut phi = vec![0.0f64; n];
+        let mut acc = 0.0;
+        for r in 1..n {
+            let d = self.delta[r];
+            let norm = (rho * rho + d * d).sqrt();
+            let slope = if norm > 0.0 { -d / norm } else { 0.0 };
+            let (q, q_prev) = (self.s0[r] as usize, self.s0[r - 1] as usize);
+            acc += slope * (x0[q][self.axis] - x0[q_prev][self.axis]);
+            phi[q] = acc;
+        }
+        let pmin = phi.iter().copied().fold(f64::INFINITY, f64::min);
+        phi.iter()
+            .map(|&f| -((f - pmin) / unit).round() as i64)
+            .collect()
+    }
 }
 
 /// Compressed sparse rows: row `p`'s edges are `cols[offsets[p]..offsets[p + 1]]` with
@@ -139,7 +253,7 @@ mod tests {
         let x1 = vec![[10.2, 0.0, 0.0], [-3.0, 0.0, 0.0]];
         let scale = CostScale::new(&x0, &x1, 1e-3).unwrap();
         let tree = build_tree(&x0);
-        let (c, w) = knn(&tree, &x0, &x1, 3, &scale);
+        let (c, w) = knn(&tree, &x0, &x1, &x1, 3, &scale);
         assert_eq!(&c[..3], &[10, 11, 9]);
         assert_eq!(&w[..3], &[200, 800, 1200]);
         assert_eq!(&c[3..], &[0, 1, 2]);

@@ -56,6 +56,12 @@ pub(crate) struct WeightedTree {
     nodes: Vec<Node>,
     /// Node minima of `W`, parallel to `nodes`.
     wmin: Vec<f64>,
+    /// Node minima of `W − x_a` (`[0..3]`) and `W + x_a` (`[3..6]`) per axis `a`,
+    /// parallel to `nodes`: since `d(p, q) >= ±(p_a − q_a)`, `d + W_q >= p_a +
+    /// min(W − x_a)` and `>= −p_a + min(W + x_a)`. Where the potentials slope along
+    /// the bed (a long drum whose particles drift along its axis), these bounds prune
+    /// the nodes far along the slope that `mindist + W_min` cannot.
+    wlin: Vec<[f64; 6]>,
     /// Points and their t0 indices, in tree order (leaves contiguous).
     pts: Vec<[f64; 3]>,
     idx: Vec<u32>,
@@ -75,6 +81,7 @@ impl WeightedTree {
         Self {
             nodes,
             wmin: vec![0.0; n],
+            wlin: vec![[0.0; 6]; n],
             pts,
             idx,
             w: vec![0.0; x0.len()],
@@ -89,19 +96,31 @@ impl WeightedTree {
         // Children come after their parent in `nodes`, so a reverse sweep is bottom-up.
         for i in (0..self.nodes.len()).rev() {
             let nd = &self.nodes[i];
-            self.wmin[i] = if nd.left == 0 {
-                self.w[nd.start as usize..nd.end as usize]
-                    .iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min)
+            if nd.left == 0 {
+                let mut m = f64::INFINITY;
+                let mut lin = [f64::INFINITY; 6];
+                for t in nd.start as usize..nd.end as usize {
+                    let (w, x) = (self.w[t], &self.pts[t]);
+                    m = m.min(w);
+                    for a in 0..3 {
+                        lin[a] = lin[a].min(w - x[a]);
+                        lin[a + 3] = lin[a + 3].min(w + x[a]);
+                    }
+                }
+                self.wmin[i] = m;
+                self.wlin[i] = lin;
             } else {
-                self.wmin[nd.left as usize].min(self.wmin[nd.right as usize])
-            };
+                let (l, r) = (nd.left as usize, nd.right as usize);
+                self.wmin[i] = self.wmin[l].min(self.wmin[r]);
+                let (a, b) = (self.wlin[l], self.wlin[r]);
+                self.wlin[i] = std::array::from_fn(|j| a[j].min(b[j]));
+            }
         }
     }
 
     /// Calls `visit(tree position)` for every point with `d + W < r`, skipping every
-    /// node with `mindist(p, box) + W_min >= r`. `stack` is scratch. Both tests are
+    /// node with `mindist(p, box) + W_min >= r` or with one of the axis bounds of
+    /// `wlin` at least `r`. `stack` is scratch. Both tests are
     /// made on squares (`d < r − W` with `r − W > 0`), without square roots; the
     /// rounding of either form is far below the margin built into `r`.
     fn search(&self, p: &[f64; 3], r: f64, stack: &mut Vec<u32>, mut visit: impl FnMut(usize)) {
@@ -112,6 +131,10 @@ impl WeightedTree {
             let nd = &self.nodes[i];
             let reach = r - self.wmin[i];
             if reach <= 0.0 || mindist2(p, &nd.lo, &nd.hi) >= reach * reach {
+                continue;
+            }
+            let lin = &self.wlin[i];
+            if (0..3).any(|a| p[a] + lin[a] >= r || lin[a + 3] - p[a] >= r) {
                 continue;
             }
             if nd.left == 0 {
@@ -301,28 +324,33 @@ mod tests {
             (s >> 11) as f64 / (1u64 << 53) as f64
         };
         let x0: Vec<[f64; 3]> = (0..700).map(|_| [rnd(), rnd(), 2.0 * rnd()]).collect();
-        let v: Vec<i64> = x0
-            .iter()
-            .map(|p| -((p[2] * 300.0) as i64) - (rnd() * 50.0) as i64)
-            .collect();
-        let v_max = *v.iter().max().unwrap();
-        let unit = 1e-3;
-        let mut tree = WeightedTree::new(&x0);
-        tree.set_weights(|q| v[q], v_max, unit);
-        let mut stack = Vec::new();
-        for _ in 0..50 {
-            let p = [rnd(), rnd(), 2.0 * rnd()];
-            let r = 0.05 + rnd() * 0.5;
-            let mut got = Vec::new();
-            tree.search(&p, r, &mut stack, |t| got.push(tree.idx[t]));
-            got.sort_unstable();
-            let want: Vec<u32> = (0..x0.len())
-                .filter(|&q| {
-                    super::super::cost::distance(&p, &x0[q]) + (v_max - v[q]) as f64 * unit < r
-                })
-                .map(|q| q as u32)
+        // Potentials sloping along z, gently and (as in a long drum whose particles
+        // drift along its axis) nearly as steeply as the cost itself, where the axis
+        // bounds of the search prune.
+        for (slope, rmax) in [(300.0, 0.5), (950.0, 2.0), (-990.0, 2.0)] {
+            let v: Vec<i64> = x0
+                .iter()
+                .map(|p| -((p[2] * slope) as i64) - (rnd() * 50.0) as i64)
                 .collect();
-            assert_eq!(got, want);
+            let v_max = *v.iter().max().unwrap();
+            let unit = 1e-3;
+            let mut tree = WeightedTree::new(&x0);
+            tree.set_weights(|q| v[q], v_max, unit);
+            let mut stack = Vec::new();
+            for _ in 0..50 {
+                let p = [rnd(), rnd(), 2.0 * rnd()];
+                let r = 0.05 + rnd() * rmax;
+                let mut got = Vec::new();
+                tree.search(&p, r, &mut stack, |t| got.push(tree.idx[t]));
+                got.sort_unstable();
+                let want: Vec<u32> = (0..x0.len())
+                    .filter(|&q| {
+                        super::super::cost::distance(&p, &x0[q]) + (v_max - v[q]) as f64 * unit < r
+                    })
+                    .map(|q| q as u32)
+                    .collect();
+                assert_eq!(got, want);
+            }
         }
     }
 }

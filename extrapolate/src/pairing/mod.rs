@@ -8,8 +8,10 @@
 //!
 //! * [`pair_dense`] — Kuhn–Munkres on the full matrix; the oracle, small n only.
 //! * [`pair`] — the solver for real beds: on the k nearest t0 neighbours of each t1
-//!   point, an ε-scaling auction as a warm start, then shortest augmenting paths
-//!   (Jonker–Volgenant, Dijkstra on reduced costs); exit edges added on
+//!   point (queried where the transport along the bed's long axis sends it), an
+//!   ε-scaling auction as a warm start (potentials started from that transport),
+//!   then shortest augmenting paths (Jonker–Volgenant, Dijkstra on reduced costs);
+//!   exit edges added on
 //!   Hall-violating sets while the candidate graph has no perfect matching; then an
 //!   optimality certificate against every excluded pair, through the dual potentials
 //!   (pairs it finds are added and the solve repeated, warm-started, until it holds).
@@ -41,7 +43,8 @@ pub struct PairingOptions {
     /// millionth of a particle diameter, far below any physical meaning, while keeping
     /// costs small integers (≈ 6·10⁸ for the length of the paper's drum).
     pub unit: f64,
-    /// Number of nearest t0 candidates per t1 point (≥ 1). If they admit no perfect
+    /// Number of nearest t0 candidates per t1 point (≥ 1); multiplied by 4/3 on a bed
+    /// with a large transport along its long axis (docs/pairing.md). If they admit no perfect
     /// matching (detected when the auction warm start runs out of bids), k doubles
     /// once; if that is still not enough, exit edges are added on the Hall-violating
     /// sets (`growth_pairs`).
@@ -77,8 +80,9 @@ pub struct Pairing {
     pub total_cost: i64,
     /// `Σ_p |x1[p] − x0[g[p]]|`, in the units of the coordinates (summed in row order).
     pub total_distance: f64,
-    /// Nearest t0 candidates per row in the kNN lists: `k_initial`, or twice that if
-    /// the first kNN graph had no perfect matching, capped at n; `n` for the dense
+    /// Nearest t0 candidates per row in the kNN lists: `k_initial` (times 4/3 on a bed
+    /// with a large axial transport), or twice that if the first kNN graph had no
+    /// perfect matching, capped at n; `n` for the dense
     /// oracle. Growth adds individual edges, counted in `growth_pairs`.
     pub k_used: usize,
     /// True if the result is proven optimal for the complete problem (the dense oracle,
@@ -269,6 +273,11 @@ const AUCTION_BIDS_PER_ROW: u64 = 200;
 /// ε shrinks by this factor between auction phases.
 const AUCTION_THETA: i64 = 8;
 
+/// When the mean axial transport exceeds the mean cheapest pair distance, k is
+/// multiplied by `AXIAL_K_NUM / AXIAL_K_DEN` (24 → 32).
+const AXIAL_K_NUM: usize = 4;
+const AXIAL_K_DEN: usize = 3;
+
 /// Certificate searches made on the auction's potentials, each followed by more
 /// auction on the enlarged graph (see `sparse`).
 const AUCTION_ROUNDS: usize = 2;
@@ -276,6 +285,61 @@ const AUCTION_ROUNDS: usize = 2;
 /// With the certificate, the first auction pauses at its initial ε divided by this,
 /// and the auctions that follow the certificate searches start from there.
 const AUCTION_REFINE: i64 = 16;
+
+/// `TDEX_PAIR_TRACE` set: phase timings and counters of the sparse solver on stderr
+/// (diagnostics only; the result does not depend on it).
+fn trace_on() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var_os("TDEX_PAIR_TRACE").is_some())
+}
+
+macro_rules! trace {
+    ($t:expr, $($arg:tt)*) => {
+        if trace_on() {
+            eprintln!("[pair {:8.3} s] {}", $t.elapsed().as_secs_f64(), format!($($arg)*));
+        }
+    };
+}
+
+/// Summary of a list of added pairs for the trace: rows, mean and max cost (in units of
+/// 10⁶ cost units, one diameter at the default unit), y quantiles of the rows.
+fn describe(
+    pairs: &[(u32, u32)],
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    scale: &cost::CostScale,
+) -> String {
+    if pairs.is_empty() {
+        return "none".into();
+    }
+    let mut rows: Vec<u32> = pairs.iter().map(|e| e.0).collect();
+    rows.dedup();
+    let costs: Vec<i64> = pairs
+        .iter()
+        .map(|&(p, q)| scale.cost(&x1[p as usize], &x0[q as usize]))
+        .collect();
+    let mean = costs.iter().sum::<i64>() as f64 / costs.len() as f64 * 1e-6;
+    let max = *costs.iter().max().unwrap() as f64 * 1e-6;
+    let mut ys: Vec<f64> = rows.iter().map(|&p| x1[p as usize][1]).collect();
+    ys.sort_by(f64::total_cmp);
+    let qy = |f: f64| ys[((ys.len() - 1) as f64 * f) as usize];
+    let dy: f64 = pairs
+        .iter()
+        .map(|&(p, q)| (x1[p as usize][1] - x0[q as usize][1]).abs())
+        .sum::<f64>()
+        / pairs.len() as f64
+        / (scale.unit() * 1e6);
+    format!(
+        "{} pairs on {} rows, cost mean {mean:.2} max {max:.2} (1e6 units), mean |dy| {dy:.2}, row y q0/10/50/90/100 {:.3} {:.3} {:.3} {:.3} {:.3}",
+        pairs.len(),
+        rows.len(),
+        qy(0.0),
+        qy(0.1),
+        qy(0.5),
+        qy(0.9),
+        qy(1.0)
+    )
+}
 
 /// The sparse solver: renumber, build the kNN graph, warm-start with an auction, solve
 /// (adding exit edges if the graph has no perfect matching), certify, repair, repeat.
@@ -286,6 +350,7 @@ fn sparse(
     scale: &cost::CostScale,
 ) -> Pairing {
     let n = x0_in.len();
+    let t = Instant::now();
     // Work on a Morton-ordered copy (cache locality); map back at the end.
     let (lo, hi) = order::bounds(x0_in, x1_in);
     let perm0 = order::morton_order(x0_in, lo, hi);
@@ -294,13 +359,44 @@ fn sparse(
     let x1: Vec<[f64; 3]> = perm1.iter().map(|&i| x1_in[i as usize]).collect();
     let (x0, x1) = (&x0[..], &x1[..]);
     let tree = candidates::build_tree(x0);
+    trace!(t, "morton order + kiddo tree, n {n}");
 
+    // Candidates and warm-start potentials follow the transport along the bed's long
+    // axis (`candidates::Axial`; docs/pairing.md, "Long drums").
+    let axial = candidates::Axial::new(x0, x1);
+    let centres = axial.centres(x1);
     let mut k0 = opts.k_initial.min(n);
-    let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, k0, scale);
+    let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
     let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+    let mut rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
+    let shift = axial.mean_abs_shift();
+    trace!(
+        t,
+        "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}) + knn k {k0} + graph"
+    );
+    // A bed with a large axial transport needs more candidates: the paper's drum has
+    // no perfect matching at k = 24, and finding that out costs the auction's whole
+    // budget (docs/pairing.md, "Long drums").
+    if shift > rho && k0 < n {
+        k0 = (k0 * AXIAL_K_NUM / AXIAL_K_DEN).clamp(1, n);
+        (kc, kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
+        graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+        rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
+        trace!(t, "large axial transport: knn k {k0} + graph");
+    }
+    let v_axial = axial.potentials(x0, rho, scale.unit());
     let mut lap = sparse_lap::Lap::new(n);
+    lap.set_potentials(&v_axial);
     lap.greedy_init(&graph);
+    trace!(
+        t,
+        "axial potentials + row reduction: {} rows free",
+        lap.col_of_row
+            .iter()
+            .filter(|&&q| q == sparse_lap::NONE)
+            .count()
+    );
     // Warm start: the row reduction, then an ε-scaling auction. The auction moves the
     // holes left by the row reduction (the long-range part of the transport) far more
     // cheaply than one Dijkstra search per hole, which scans the whole region between
@@ -321,21 +417,36 @@ fn sparse(
         }
     };
     let mut bids = lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+    trace!(
+        t,
+        "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
+        eps_pause(eps0),
+        lap.col_of_row
+            .iter()
+            .filter(|&&q| q == sparse_lap::NONE)
+            .count()
+    );
     // An auction that stops on its budget may be bidding on a graph without a perfect
     // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
     // redone: exit edges (the growth step below) are long, and their potentials make
     // the certificate expensive. A real bed whose t1 shape differs slightly from t0's
-    // has no perfect matching at k = 12 or 16 (docs/pairing.md).
+    // has no perfect matching at k = 12 or 16, the paper's drum none at k = 24
+    // (docs/pairing.md). Checking up front instead costs 1.1–1.3 s of Hopcroft–Karp
+    // on the paper's drum, feasible or not (its augmenting paths are long).
     if lap.col_of_row.contains(&sparse_lap::NONE) && k0 < n {
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
-            (kc, kw) = candidates::knn(&tree, x0, x1, k0, scale);
+            (kc, kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
             graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
             lap = sparse_lap::Lap::new(n);
+            lap.set_potentials(&v_axial);
             lap.greedy_init(&graph);
             eps0 = sparse_lap::initial_eps(&graph);
             bids += lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+            trace!(t, "k doubled to {k0}, auction again: {bids} bids in all");
+        } else {
+            trace!(t, "Hopcroft-Karp: the graph has a perfect matching");
         }
     }
     let mut wtree: Option<certificate::WeightedTree> = None;
@@ -351,6 +462,12 @@ fn sparse(
         // return candidate edges (dropped by the merge) and proves nothing.
         let check = certificate::check(wtree, x1, &lap, scale, &mut certificate::Memo::default());
         examined += check.examined;
+        trace!(
+            t,
+            "auction certificate search: {} examined, {}",
+            check.examined,
+            describe(&check.violations, x0, x1, scale)
+        );
         if check.violations.is_empty() {
             break;
         }
@@ -360,12 +477,15 @@ fn sparse(
         added += graph.edges() - before;
         // The auction frees the rows undercut by more than ε by a new edge.
         bids += lap.auction(&graph, eps_pause(eps0), AUCTION_THETA, 1, budget);
+        trace!(t, "auction to 1: {bids} bids in all");
         paused = false;
     }
     if paused && !lap.col_of_row.contains(&sparse_lap::NONE) {
         bids += lap.auction(&graph, eps_pause(eps0), AUCTION_THETA, 1, budget);
+        trace!(t, "auction to 1: {bids} bids in all");
     }
-    lap.restore_invariant(&graph);
+    let freed = lap.restore_invariant(&graph);
+    trace!(t, "restore invariant: {freed} rows freed");
 
     // Optimal on the candidate graph, then the certificate; repair until it holds.
     // If a search finds no augmenting path, the graph has no perfect matching: add exit
@@ -376,7 +496,9 @@ fn sparse(
     let mut grown = 0usize;
     let certified = loop {
         rounds += 1;
+        let work0 = lap.work;
         while let Err(failed) = lap.solve(&graph) {
+            trace!(t, "solve failed at row {}: growth", failed.row);
             let before = grown;
             let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
             loop {
@@ -397,13 +519,25 @@ fn sparse(
                 failed.row
             );
             lap.restore_invariant(&graph);
+            trace!(t, "growth: {} exit edges in all", grown);
         }
+        trace!(
+            t,
+            "round {rounds}: solve scanned {} columns",
+            lap.work - work0
+        );
         if !opts.certify {
             break false;
         }
         let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
         let check = certificate::check(wtree, x1, &lap, scale, &mut memo);
         examined += check.examined;
+        trace!(
+            t,
+            "round {rounds}: certificate {} examined, {}",
+            check.examined,
+            describe(&check.violations, x0, x1, scale)
+        );
         if check.violations.is_empty() {
             break true;
         }
@@ -412,7 +546,8 @@ fn sparse(
         added += check.violations.len();
         extras = merge(extras, check.violations);
         graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
-        lap.restore_invariant(&graph);
+        let freed = lap.restore_invariant(&graph);
+        trace!(t, "round {rounds}: {freed} rows freed");
     };
 
     // Back to the caller's numbering.

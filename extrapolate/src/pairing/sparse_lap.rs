@@ -89,6 +89,15 @@ impl Lap {
         }
     }
 
+    /// Sets the column potentials before any matching is made (all must be `<= 0`).
+    pub(crate) fn set_potentials(&mut self, v: &[i64]) {
+        debug_assert!(self.col_of_row.iter().all(|&q| q == NONE));
+        for (c, &v) in self.cols.iter_mut().zip(v) {
+            debug_assert!(v <= 0);
+            c.v = v;
+        }
+    }
+
     /// Column potential `v[q]`.
     #[inline]
     pub(crate) fn v(&self, q: usize) -> i64 {
@@ -431,6 +440,15 @@ fn auction_phases(
         }
         eps = (eps / theta.max(2)).max(eps_min);
     }
+}
+
+/// Mean cost of the rows' cheapest candidates (at least 0).
+pub(crate) fn mean_cheapest(g: &Graph) -> f64 {
+    let rows = g.rows().max(1);
+    let sum: i128 = (0..g.rows())
+        .map(|p| g.row(p).1.iter().copied().min().unwrap_or(0) as i128)
+        .sum();
+    sum as f64 / rows as f64
 }
 
 /// Initial ε of the auction: the power of two nearest to twice the mean cost of the
