@@ -22,12 +22,10 @@ pub struct Floor {
     pub ratio_to_floor: Option<f64>,
 }
 
-impl Floor {
-    /// Whether the extrapolation is within the DEM runs' own range at this `t_k`: no farther
-    /// from them on average than the two farthest runs are from each other.
-    pub fn within_range(&self) -> bool {
-        self.eps_abs_to_dem_runs <= self.floor_eps_abs_max
-    }
+/// Whether an extrapolation is within the DEM runs' own range at one `t_k`: its mean distance
+/// `to_runs` to them no larger than the largest distance `max` between two of them.
+pub fn within(to_runs: f64, max: f64) -> bool {
+    to_runs <= max
 }
 
 /// The cell means of one field: positions and temperatures in the same order.
@@ -112,7 +110,7 @@ mod tests {
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         // absent, not infinite: a floor of 0 gives nothing to divide by
         assert_eq!(f.ratio_to_floor, None);
-        assert!(!f.within_range());
+        assert!(!within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
     }
 
     #[test]
@@ -135,12 +133,12 @@ mod tests {
         assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         assert_eq!(f.ratio_to_floor, Some(0.5));
-        assert!(f.within_range());
+        assert!(within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
         // a field 3 K off in the first cell is farther than the runs are from each other
         let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)]).unwrap();
         assert_eq!(far.eps_abs_to_dem_runs, 1.5);
         assert_eq!(far.ratio_to_floor, Some(1.5));
-        assert!(!far.within_range());
+        assert!(!within(far.eps_abs_to_dem_runs, far.floor_eps_abs_max));
         // one run alone has no floor
         assert_eq!(floor(&cells(), &runs[..1], &[Some(15.0), Some(35.0)]), None);
     }

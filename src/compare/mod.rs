@@ -9,7 +9,7 @@ pub mod verdict;
 use crate::cli::ComparePlan;
 use crate::cli::UsageError;
 use anyhow::{Context, Result};
-use floor::{Field, Floor};
+use floor::Field;
 use metrics::Cells;
 use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 use serde::Serialize;
@@ -115,16 +115,12 @@ pub struct PeriodComparison {
 }
 
 impl PeriodComparison {
-    /// The floor at this `t_k`, if measured.
-    pub fn floor(&self) -> Option<Floor> {
-        Some(Floor {
-            floor_eps_abs: self.floor_eps_abs?,
-            floor_eps_abs_min: self.floor_eps_abs_min?,
-            floor_eps_abs_max: self.floor_eps_abs_max?,
-            floor_pairs: 0,
-            eps_abs_to_dem_runs: self.eps_abs_to_dem_runs?,
-            ratio_to_floor: self.ratio_to_floor,
-        })
+    /// Whether the second field is farther from the DEM runs than the two farthest of them
+    /// are from each other at this `t_k` (false without a floor).
+    pub fn outside_floor_range(&self) -> bool {
+        self.eps_abs_to_dem_runs
+            .zip(self.floor_eps_abs_max)
+            .is_some_and(|(to_runs, max)| !floor::within(to_runs, max))
     }
 }
 
@@ -371,11 +367,11 @@ pub fn compare_runs(
     let mut unreferenced = Vec::new();
     let mut previous: Option<Snapshot> = None;
     for after in extra {
-        let after = after?;
-        let Some(before) = previous.replace(after.clone()) else {
+        // the snapshot before moves out, this one stays as the next one's before: no copy
+        let Some(before) = previous.replace(after?) else {
             continue;
         };
-        let (before, after) = (&before, &after);
+        let (before, after) = (&before, previous.as_ref().expect("set just above"));
         let k = after.index;
         let (Some(dem_before), Some(dem_after)) = (dem_at(before.index), dem_at(k)) else {
             unreferenced.push(k);

@@ -86,7 +86,7 @@ impl Verdict {
         let compared: Vec<u32> = rated.iter().map(|r| r.0).collect();
         let outside_range: Vec<u32> = periods
             .iter()
-            .filter(|p| p.floor().is_some_and(|f| !f.within_range()))
+            .filter(|p| p.outside_floor_range())
             .map(|p| p.k)
             .collect();
         // group means (bed mean for a bed without groups): the extrapolation's error and the
