@@ -58,6 +58,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         stream: false,
         max_memory: None,
         threads: plan.threads,
+        reproducible: false,
         json: false,
     })?;
 

@@ -68,7 +68,10 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
     let (stored, reused) = match stored_pairing {
         Some(stored) => (stored, true),
         None => {
-            let stored = pair::compute(&t0, &t1)?;
+            let mut stored = pair::compute(&t0, &t1)?;
+            if plan.reproducible {
+                stored.summary = stored.summary.reproducible();
+            }
             // the stored pairing only saves time next run: a recording on a full or read-only
             // disk is still extrapolated
             if let Err(e) = pair::store(&reader, &stored) {
@@ -106,7 +109,12 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         recording_info: info.clone(),
         scheme: plan.scheme.name().into(),
         periods: plan.periods,
-        pairing: serde_json::to_value(&stored.summary)?,
+        pairing: serde_json::to_value(if plan.reproducible {
+            // a stored pairing made without --reproducible carries its time
+            stored.summary.clone().reproducible()
+        } else {
+            stored.summary.clone()
+        })?,
     };
     let mut writer = ExtrapolationWriter::create(&plan.output, &out_info)?;
     writer.write_snapshot(&t1)?;
@@ -165,7 +173,7 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         rows_per_second: rows as f64 * plan.periods as f64 / seconds_replay.max(1e-12),
         rows,
     };
-    writer.finish(&costs)?;
+    writer.finish((!plan.reproducible).then_some(&costs))?;
     let report = ExtrapolationReport {
         output: plan.output.display().to_string(),
         scheme: plan.scheme.name().into(),

@@ -50,8 +50,8 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing> {
             k_used: p.k_used,
             certified: p.certified,
             rounds: p.rounds,
-            seconds: p.seconds,
-            threads: rayon::current_num_threads(),
+            seconds: Some(p.seconds),
+            threads: Some(rayon::current_num_threads()),
         },
         g: p.g,
     })
@@ -77,9 +77,13 @@ pub fn store(reader: &RecordingReader, stored: &StoredPairing) -> Result<PathBuf
 pub fn run(plan: &PairPlan) -> Result<()> {
     let reader = RecordingReader::open(&plan.file)?;
     let (t0, t1) = period_snapshots(&reader)?;
-    let stored = crate::with_workers(plan.threads, || compute(&t0, &t1))?;
+    let mut stored = crate::with_workers(plan.threads, || compute(&t0, &t1))?;
+    let measured = stored.summary.clone();
+    if plan.reproducible {
+        stored.summary = stored.summary.reproducible();
+    }
     let path = store(&reader, &stored)?;
-    let s = &stored.summary;
+    let s = &measured;
     // replaying one period applies g again and again: each particle only ever plays the
     // roles of its own cycle
     let cycles = pairing::cycle_structure(&stored.g);
@@ -112,8 +116,8 @@ pub fn run(plan: &PairPlan) -> Result<()> {
         );
         println!(
             "time          {:.3} s on {} threads; stored in {}",
-            s.seconds,
-            s.threads,
+            s.seconds.unwrap_or_default(),
+            s.threads.unwrap_or_default(),
             path.display()
         );
     }

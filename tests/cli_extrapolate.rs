@@ -1,4 +1,4 @@
-//! `tdex extrapolate --max-memory`: the memory stated before the work, a table that does not fit streamed from the file with the same bytes out as in memory, and a limit below the per-particle state refused.
+//! `tdex extrapolate`: the memory stated before the work (`--max-memory`), a table that does not fit streamed from the file with the same bytes out as in memory, a limit below the per-particle state refused, and `--reproducible` pairings and extrapolations that are the same bytes whatever the thread count.
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
@@ -163,4 +163,43 @@ fn a_limit_below_the_per_particle_state_is_refused_before_any_work() {
     // sizes as a user writes them
     let o = extrapolate(&run, &out, &["--max-memory", "1.5G"]);
     assert_eq!(json_of(&o)["memory"]["limit_bytes"].as_u64(), Some(3 << 29));
+}
+
+#[test]
+fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("tiny.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    let run = dir.path().join("run.mcap");
+    let run_s = run.to_str().unwrap();
+    tdex_ok(&["record", case.to_str().unwrap(), "-o", run_s, "--reproducible"]);
+    let sidecar = dir.path().join("run.mcap.pairing.json");
+    let mut pairings = Vec::new();
+    for threads in ["1", "2"] {
+        tdex_ok(&["pair", run_s, "--threads", threads, "--reproducible"]);
+        pairings.push(std::fs::read(&sidecar).unwrap());
+    }
+    assert!(pairings[0] == pairings[1], "the sidecar depends on the threads");
+    let text = String::from_utf8_lossy(&pairings[0]);
+    assert!(!text.contains("seconds") && !text.contains("threads"), "{text}");
+
+    // the extrapolation computes its own pairing (no sidecar) on each thread count
+    let mut files = Vec::new();
+    for threads in ["1", "2"] {
+        std::fs::remove_file(&sidecar).unwrap();
+        let out = dir.path().join(format!("extra{threads}.mcap"));
+        json_of(&extrapolate(
+            &run,
+            &out,
+            &["--threads", threads, "--reproducible"],
+        ));
+        files.push(std::fs::read(&out).unwrap());
+    }
+    assert!(files[0] == files[1], "the extrapolation depends on the threads");
+    let costs = b"tdex.extrapolation_costs";
+    assert!(!files[0].windows(costs.len()).any(|w| w == costs));
+    // without the flag the file holds the costs record
+    let timed = dir.path().join("timed.mcap");
+    json_of(&extrapolate(&run, &timed, &[]));
+    assert!(!up_to_costs(&timed).is_empty());
 }

@@ -13,8 +13,21 @@ pub struct PairingSummary {
     pub k_used: usize,
     pub certified: bool,
     pub rounds: u32,
-    pub seconds: f64,
-    pub threads: usize,
+    /// Wall time and worker threads of the solve; left out of a reproducible pairing
+    /// (`tdex pair --reproducible`), the only fields that depend on the machine.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub seconds: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<usize>,
+}
+
+impl PairingSummary {
+    /// The summary without the machine-dependent fields (time, threads).
+    pub fn reproducible(mut self) -> Self {
+        self.seconds = None;
+        self.threads = None;
+        self
+    }
 }
 
 /// The stored pairing: `g[p]` = the role particle `p` takes in the next period.

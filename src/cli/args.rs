@@ -77,6 +77,10 @@ pub enum Command {
         /// Worker threads (default: all cores). The pairing does not depend on it.
         #[arg(long)]
         threads: Option<usize>,
+        /// Leave the time and thread count out of the stored pairing: the same recording
+        /// then gives the same file byte for byte.
+        #[arg(long)]
+        reproducible: bool,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -107,6 +111,10 @@ pub enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Leave the costs record (wall times, thread count) out of the extrapolation: the
+        /// same recording and flags then give the same file byte for byte.
+        #[arg(long)]
+        reproducible: bool,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
         json: bool,

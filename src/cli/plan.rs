@@ -128,6 +128,7 @@ pub struct ComparePlan {
 pub struct PairPlan {
     pub file: PathBuf,
     pub threads: usize,
+    pub reproducible: bool,
     pub json: bool,
 }
 
@@ -140,6 +141,7 @@ pub struct ExtrapolatePlan {
     /// `--max-memory` in bytes; `None`: a share of the memory available when it starts.
     pub max_memory: Option<u64>,
     pub threads: usize,
+    pub reproducible: bool,
     pub json: bool,
 }
 
@@ -294,10 +296,12 @@ impl Plan {
             Command::Pair {
                 file,
                 threads: t,
+                reproducible,
                 json,
             } => Ok(Plan::Pair(PairPlan {
                 file,
                 threads: threads(t)?,
+                reproducible,
                 json,
             })),
             Command::Extrapolate {
@@ -308,6 +312,7 @@ impl Plan {
                 stream,
                 max_memory,
                 threads: t,
+                reproducible,
                 json,
             } => {
                 let threads = threads(t)?;
@@ -331,6 +336,7 @@ impl Plan {
                     stream,
                     max_memory,
                     threads,
+                    reproducible,
                     json,
                 }))
             }

@@ -106,6 +106,7 @@ pub fn evaluate(
         stream: false,
         max_memory: None,
         threads,
+        reproducible: false,
         json: true,
     };
     if let Err(e) = crate::with_workers(threads, || extrapolation::extrapolate(&plan)) {

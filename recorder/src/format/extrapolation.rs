@@ -79,11 +79,15 @@ impl ExtrapolationWriter {
         result.map_err(|e| FormatError::writing(&self.dest, e))
     }
 
-    pub fn finish(mut self, costs: &ExtrapolationCosts) -> Result<(), FormatError> {
+    /// Closes the file into place; `costs` is `None` for a reproducible extrapolation
+    /// (`tdex extrapolate --reproducible`), whose bytes then depend on nothing but its inputs.
+    pub fn finish(mut self, costs: Option<&ExtrapolationCosts>) -> Result<(), FormatError> {
         let mut mcap = self.mcap.take().expect("finished once");
-        if let Err(e) = write_json_metadata(&mut mcap, EXTRAPOLATION_COSTS_METADATA, costs) {
-            abandon(mcap);
-            return Err(FormatError::writing(&self.dest, e));
+        if let Some(costs) = costs {
+            if let Err(e) = write_json_metadata(&mut mcap, EXTRAPOLATION_COSTS_METADATA, costs) {
+                abandon(mcap);
+                return Err(FormatError::writing(&self.dest, e));
+            }
         }
         close_into_place(mcap, &self.dest)
     }
