@@ -107,14 +107,14 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         tool_version: env!("CARGO_PKG_VERSION").into(),
         recording: plan.file.display().to_string(),
         recording_info: info.clone(),
-        scheme: plan.scheme.name().into(),
+        scheme: plan.scheme,
         periods: plan.periods,
-        pairing: serde_json::to_value(if plan.reproducible {
+        pairing: if plan.reproducible {
             // a stored pairing made without --reproducible carries its time
             stored.summary.clone().reproducible()
         } else {
             stored.summary.clone()
-        })?,
+        },
     };
     let mut writer = ExtrapolationWriter::create(&plan.output, &out_info)?;
     writer.write_snapshot(&t1)?;

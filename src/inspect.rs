@@ -519,9 +519,10 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         sampling: Sampling::of(ri),
         walls: ri.walls.len(),
         conducting_walls,
-        scheme: info.scheme.clone(),
+        scheme: info.scheme.name().into(),
         periods: info.periods,
-        pairing: info.pairing.clone(),
+        // keys in the order the file holds them (sorted)
+        pairing: serde_json::to_value(&info.pairing)?,
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,

@@ -1,6 +1,6 @@
 //! The fuzz regression corpus (`tests/corpus/<target>/`, docs/reliability.md) replayed through the fuzz targets' own entry points: every input returns, never panics.
 
-use extrapolate::fuzzing;
+use recorder::fuzzing;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 

@@ -79,7 +79,7 @@ fn report_d(name: &str, r: &Pairing, d: f64) {
 
 /// The t0/t1 snapshots of a recording, tiled `tile` times along y; also the diameter.
 fn load_recording(path: &str, tile: usize) -> (Vec<[f64; 3]>, Vec<[f64; 3]>, f64) {
-    let reader = recorder::format::RecordingReader::open(std::path::Path::new(path)).unwrap();
+    let reader = tdex_format::RecordingReader::open(std::path::Path::new(path)).unwrap();
     let s0 = reader.snapshot(0).unwrap().expect("no t0 snapshot");
     let s1 = reader.snapshot(1).unwrap().expect("no t1 snapshot");
     let d = 2.0 * s0.radius.iter().sum::<f64>() / s0.radius.len() as f64;

@@ -2,7 +2,7 @@
 //! issue 4): [`pairing`] finds the roles, [`replay`] applies the table period after period,
 //! [`sidecar`] stores the pairing beside the recording.
 
-pub mod fuzzing;
 pub mod pairing;
 pub mod replay;
-pub mod sidecar;
+
+pub use tdex_format::sidecar;

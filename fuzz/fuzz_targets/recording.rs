@@ -6,5 +6,5 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     // Ok or Err are both fine; a panic, an abort or a runaway allocation is a finding.
-    let _ = extrapolate::fuzzing::run("recording", data);
+    let _ = recorder::fuzzing::run("recording", data);
 });

@@ -12,7 +12,6 @@ pub mod case;
 pub mod contact;
 pub mod counters;
 pub mod export;
-pub mod format;
 pub mod fuzzing;
 pub mod heat;
 pub mod import;
@@ -20,7 +19,6 @@ pub mod insertion;
 pub mod integrate;
 pub mod math;
 pub mod neighbor;
-pub mod output;
 pub mod particles;
 pub mod pipeline;
 pub mod prefetch;
@@ -30,4 +28,7 @@ pub mod slices;
 pub mod wall;
 
 pub use case::{Case, CaseError};
+/// The file contract lives in its own crate (`recorder/format`); these paths keep reading
+/// as before for the engine's own modules.
+pub use tdex_format::{self as format, output};
 pub use simulation::{Simulation, SimulationError};

@@ -289,11 +289,9 @@ pub fn document(inp: &Inputs) -> Document {
     };
     let pairing = &inp.extrapolation.pairing;
     let pairing_text = {
-        let mean = pairing
-            .get("mean_distance_diameters")
-            .and_then(|v| v.as_f64());
-        let certified = pairing.get("certified").and_then(|v| v.as_bool());
-        let seconds = pairing.get("seconds").and_then(|v| v.as_f64());
+        let mean = Some(pairing.mean_distance_diameters);
+        let certified = Some(pairing.certified);
+        let seconds = pairing.seconds;
         format!(
             "mean distance {} diameters; certified optimal: {}; computed in {} s",
             opt(mean, |m| sig(m, 4)),
@@ -372,7 +370,7 @@ pub fn document(inp: &Inputs) -> Document {
                     None => "adiabatic".into(),
                 },
             ),
-            row("Extrapolation scheme", inp.extrapolation.scheme.clone()),
+            row("Extrapolation scheme", inp.extrapolation.scheme.name().into()),
             row(
                 "Extrapolated periods",
                 format!("{periods} ({})", span(periods + 1)),

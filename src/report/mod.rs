@@ -157,11 +157,7 @@ pub fn write_with(
 
     let costs = match (recording.costs(), extrapolation.costs()) {
         (Some(rc), Some(ec)) => {
-            let pairing_seconds = extrapolation
-                .info()
-                .pairing
-                .get("seconds")
-                .and_then(|v| v.as_f64());
+            let pairing_seconds = extrapolation.info().pairing.seconds;
             Ok(CostTable::new(
                 rc,
                 info.reference_periods,

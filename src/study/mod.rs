@@ -127,7 +127,7 @@ pub fn evaluate(
     let abs: Vec<f64> = o.energy_error.iter().flatten().map(|e| e.abs()).collect();
     o.energy_error_mean_abs = (!abs.is_empty()).then(|| abs.iter().sum::<f64>() / abs.len() as f64);
     if let (Some(rc), Some(ec)) = (rec.costs(), ext.costs()) {
-        let pairing = ext.info().pairing.get("seconds").and_then(|v| v.as_f64());
+        let pairing = ext.info().pairing.seconds;
         let table = CostTable::new(rc, rec.info().reference_periods, ec, pairing);
         o.speedup_100 = table.speedup(TABLE_PERIODS as f64);
     }

@@ -7,8 +7,8 @@
 
 use super::table::Exchange;
 use super::ReplayError;
-use recorder::format::table::BATCH_ROWS;
-use recorder::record::CollisionRow;
+use tdex_format::table::BATCH_ROWS;
+use tdex_format::CollisionRow;
 
 /// One row of the table held in memory (an [`Exchange`]).
 pub const ROW_BYTES: u64 = std::mem::size_of::<Exchange>() as u64;

@@ -3,41 +3,7 @@
 
 use super::table::{Bodies, Exchange};
 
-/// How the rows update the temperatures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Scheme {
-    /// The paper's: rows one after the other, `Q = H (T_k − T_l)` held for `m`.
-    Explicit,
-    /// Rows one after the other, each relaxing its pair exactly:
-    /// `ΔT ← ΔT · exp(−H m (1/C_k + 1/C_l))`; unconditionally stable.
-    Exact,
-    /// Rows with the same start applied at once from the temperatures before them, as the
-    /// DEM updates all contacts of a step together.
-    Synchronous,
-}
-
-impl Scheme {
-    pub const ALL: [Scheme; 3] = [Scheme::Explicit, Scheme::Exact, Scheme::Synchronous];
-
-    /// The scheme's name on the command line and in the files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Scheme::Explicit => "explicit",
-            Scheme::Exact => "exact",
-            Scheme::Synchronous => "synchronous",
-        }
-    }
-}
-
-impl std::str::FromStr for Scheme {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Scheme::ALL
-            .into_iter()
-            .find(|scheme| scheme.name() == s)
-            .ok_or_else(|| format!("unknown scheme '{s}': use explicit, exact or synchronous"))
-    }
-}
+pub use tdex_format::Scheme;
 
 /// The synchronous scheme's group in progress: the deltas of the rows that started at
 /// `group_start`, applied when a row with another start arrives or at [`Self::flush`].

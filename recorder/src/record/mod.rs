@@ -15,17 +15,4 @@ pub use recording::{
 };
 pub use sampler::ContactSampler;
 
-/// One row of the collision table, times in DEM steps from the recording's origin.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct CollisionRow {
-    /// Smaller particle id of the pair (fixed ids).
-    pub i: u32,
-    /// Larger particle id.
-    pub j: u32,
-    /// First step of the row.
-    pub start_step: u64,
-    /// Duration `m` in steps: samples × `n`, at most `Δt_c^max`.
-    pub duration_steps: u32,
-    /// Mean of `sqrt(contact area)` over the row's samples (m).
-    pub sqrt_area: f64,
-}
+pub use tdex_format::CollisionRow;

@@ -10,7 +10,7 @@ use crate::case::Case;
 use crate::format::Snapshot;
 use crate::format::{
     AreaEncoding, FormatError, RecordingCosts, RecordingInfo, RecordingSummary, RecordingWriter,
-    WallInfo, FORMAT_VERSION, SQRT_AREA_CODES,
+    WallInfo, WallKind, FORMAT_VERSION, SQRT_AREA_CODES,
 };
 use crate::heat::ConductionLaw;
 use crate::wall::WallSet;
@@ -1166,11 +1166,10 @@ impl RunAtT0 {
 /// The walls of the case's drum as table bodies `particles + w`, with their fixed
 /// temperature when they conduct.
 pub(crate) fn wall_infos(walls: &WallSet, particles: u32) -> Vec<WallInfo> {
-    let kinds = ["mantle", "cap_low", "cap_high"];
     (0..walls.len())
         .map(|w| WallInfo {
             id: particles + w as u32,
-            kind: kinds.get(w).copied().unwrap_or("wall").into(),
+            kind: WallKind::DRUM[w],
             temperature: walls.temperature(w),
         })
         .collect()

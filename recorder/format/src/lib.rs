@@ -1,10 +1,19 @@
-//! The recording file (MCAP, docs/method.md §4; layout in docs/file-format.md): what a recording
-//! holds, the writer used by `tdex record` and the streaming reader used by `extrapolate`.
+//! The file contract of tdex: what a recording, an extrapolation and a pairing sidecar hold
+//! and how they are written and read (MCAP and JSON, docs/method.md §4; layout in
+//! docs/file-format.md), the collision row they carry, and the atomic outputs every file
+//! goes through.
+//!
+//! This crate is the bottom layer: the engine and recorder (`recorder`), the pairing and
+//! replay (`extrapolate`) and the CLI read and write through it, and it depends on none of
+//! them (docs/architecture.md).
 
 pub mod extrapolation;
+pub mod fuzzing;
 mod mcap_file;
+pub mod output;
 pub mod proto;
 pub mod reader;
+pub mod sidecar;
 pub mod snapshot;
 pub mod table;
 pub mod writer;
@@ -13,6 +22,7 @@ pub use extrapolation::{
     ExtrapolationCosts, ExtrapolationInfo, ExtrapolationReader, ExtrapolationWriter,
 };
 pub use reader::RecordingReader;
+pub use sidecar::{PairingSummary, StoredPairing};
 pub use snapshot::Snapshot;
 pub use table::TableBatch;
 pub use writer::RecordingWriter;
@@ -59,13 +69,82 @@ pub enum AreaEncoding {
     Exact,
 }
 
+/// One row of the collision table, times in DEM steps from the recording's origin.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CollisionRow {
+    /// Smaller particle id of the pair (fixed ids).
+    pub i: u32,
+    /// Larger particle id.
+    pub j: u32,
+    /// First step of the row.
+    pub start_step: u64,
+    /// Duration `m` in steps: samples × `n`, at most `Δt_c^max`.
+    pub duration_steps: u32,
+    /// Mean of `sqrt(contact area)` over the row's samples (m).
+    pub sqrt_area: f64,
+}
+
+/// Which surface of the drum a wall body is (`mantle`, `cap_low`, `cap_high` in the files).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WallKind {
+    /// The cylinder, the only wall that can be heated.
+    Mantle,
+    /// The end cap at the low end of the axis (y < 0).
+    CapLow,
+    /// The end cap at the high end of the axis.
+    CapHigh,
+}
+
+impl WallKind {
+    /// A drum's walls in their body order: body `particles + w` is `DRUM[w]`.
+    pub const DRUM: [WallKind; 3] = [WallKind::Mantle, WallKind::CapLow, WallKind::CapHigh];
+}
+
+/// How the extrapolation updates the temperatures of a row's pair (docs/method.md §6).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
+pub enum Scheme {
+    /// The paper's: rows one after the other, `Q = H (T_k − T_l)` held for `m`.
+    Explicit,
+    /// Rows one after the other, each relaxing its pair exactly:
+    /// `ΔT ← ΔT · exp(−H m (1/C_k + 1/C_l))`; unconditionally stable.
+    Exact,
+    /// Rows with the same start applied at once from the temperatures before them, as the
+    /// DEM updates all contacts of a step together.
+    Synchronous,
+}
+
+impl Scheme {
+    pub const ALL: [Scheme; 3] = [Scheme::Explicit, Scheme::Exact, Scheme::Synchronous];
+
+    /// The scheme's name on the command line and in the files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scheme::Explicit => "explicit",
+            Scheme::Exact => "exact",
+            Scheme::Synchronous => "synchronous",
+        }
+    }
+}
+
+impl std::str::FromStr for Scheme {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Scheme::ALL
+            .into_iter()
+            .find(|scheme| scheme.name() == s)
+            .ok_or_else(|| format!("unknown scheme '{s}': use explicit, exact or synchronous"))
+    }
+}
+
 /// A wall that can appear in the table as body `particles + index`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WallInfo {
     /// Body id in the table: `particles + wall index`.
     pub id: u32,
-    /// `mantle`, `cap_low` or `cap_high`.
-    pub kind: String,
+    pub kind: WallKind,
     /// Fixed temperature (K) when the wall conducts; `None` for an adiabatic wall.
     pub temperature: Option<f64>,
 }

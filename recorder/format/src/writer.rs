@@ -4,7 +4,7 @@ use super::proto::{COLLISION_BATCH_DESCRIPTOR, POINT_CLOUD_DESCRIPTOR};
 use super::table::{self, BATCH_ROWS};
 use super::*;
 use crate::output::AtomicFile;
-use crate::record::CollisionRow;
+use crate::CollisionRow;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 

@@ -25,10 +25,23 @@ pub struct ExtrapolationInfo {
     /// The recording replayed (path as given) and its own info.
     pub recording: String,
     pub recording_info: RecordingInfo,
-    pub scheme: String,
+    pub scheme: Scheme,
     pub periods: u32,
-    /// The pairing's summary (see `tdex pair --json`).
-    pub pairing: serde_json::Value,
+    /// The pairing's summary (see `tdex pair --json`). Written with its keys in
+    /// alphabetical order, as the files have held it since the first version.
+    #[serde(serialize_with = "keys_sorted")]
+    pub pairing: PairingSummary,
+}
+
+/// Serialises `value` as a JSON object with its keys sorted (serde_json's map without
+/// `preserve_order`).
+fn keys_sorted<S: serde::Serializer>(
+    value: &PairingSummary,
+    serializer: S,
+) -> Result<S::Ok, S::Error> {
+    serde_json::to_value(value)
+        .map_err(serde::ser::Error::custom)?
+        .serialize(serializer)
 }
 
 /// What the extrapolation cost.

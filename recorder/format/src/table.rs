@@ -3,7 +3,7 @@
 
 use super::proto::tdex::CollisionBatch;
 use super::{AreaEncoding, RecordingInfo};
-use crate::record::CollisionRow;
+use crate::CollisionRow;
 use prost::Message;
 
 /// Rows per batch: large enough that a batch spans more than `Δt_c^max` on the small drums,
