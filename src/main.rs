@@ -3,11 +3,10 @@
 
 mod bench;
 mod cli;
-mod compare;
+mod compare_command;
 mod demo;
 mod export;
 mod extrapolation;
-mod fmt;
 mod import;
 mod inspect;
 mod pair;
@@ -18,6 +17,8 @@ mod run;
 mod study;
 
 use std::process::ExitCode;
+// the analysis modules live in the library half of this package (src/lib.rs)
+use tdex::{compare, fmt};
 
 /// Runs `work` on a pool of `threads` workers (results never depend on the count).
 fn with_workers<R: Send>(
@@ -49,7 +50,7 @@ fn main() -> ExitCode {
         cli::Plan::BenchRecord(p) => bench::record(&p),
         cli::Plan::Pair(p) => pair::run(&p),
         cli::Plan::Extrapolate(p) => extrapolation::run(&p),
-        cli::Plan::Compare(p) => compare::run(&p),
+        cli::Plan::Compare(p) => compare_command::run(&p),
         cli::Plan::Report(p) => report::run(&p),
         cli::Plan::Demo(p) => demo::run(&p),
         cli::Plan::Study(p) => study::run(&p),
@@ -65,6 +66,8 @@ fn main() -> ExitCode {
                     || e.is::<cli::UsageError>()
                     || e.is::<extrapolate::replay::ReplayError>()
                     || e.is::<extrapolate::pairing::PairingError>()
+                    || e.downcast_ref::<compare::CompareError>()
+                        .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::format::FormatError>()
                         .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::import::ImportError>()

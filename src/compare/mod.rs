@@ -6,12 +6,9 @@ pub mod floor;
 pub mod metrics;
 pub mod verdict;
 
-use crate::cli::ComparePlan;
-use crate::cli::UsageError;
-use anyhow::{Context, Result};
 use floor::Field;
 use metrics::Cells;
-use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
+use tdex_format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 use serde::Serialize;
 pub use verdict::Verdict;
 
@@ -147,74 +144,88 @@ pub struct GroupMeans {
     pub bed: f64,
 }
 
+/// Why two fields cannot be compared. Every kind but a file's own fault
+/// ([`CompareError::Format`]) is bad input: files that do not belong together.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    #[error(transparent)]
+    Format(#[from] FormatError),
+    #[error(
+        "{extrapolation} was not extrapolated from {recording} (it names {names}, and the \
+         recordings' metadata differ)"
+    )]
+    OtherRecording {
+        extrapolation: String,
+        recording: String,
+        names: String,
+    },
+    #[error("{path}: no snapshot at t{index}")]
+    MissingSnapshot { path: String, index: u32 },
+    #[error("{path} has no DEM reference after t1")]
+    NoReference { path: String },
+    #[error("{path}: only {drawn} of {cells} Voronoi seeds could be drawn inside the bed at t1")]
+    TooFewSeeds {
+        path: String,
+        drawn: usize,
+        cells: usize,
+    },
+    #[error("t_{k}: no Voronoi cell holds particles of both fields")]
+    NoSharedCell { k: u32 },
+    #[error(
+        "{second} and {recording} share no extrapolated t_k: the recording's reference ends \
+         at t_{last}"
+    )]
+    NoSharedInstant {
+        second: String,
+        recording: String,
+        last: u32,
+    },
+    #[error(
+        "{run} holds {run_particles} particles and {recording} {particles}: two DEM runs are \
+         compared only with the same particle count"
+    )]
+    ParticleCount {
+        run: String,
+        run_particles: u32,
+        recording: String,
+        particles: u32,
+    },
+    #[error(
+        "{run}: its t_{k} is at {run_time} s and {recording}'s at {time} s; two DEM runs are \
+         compared at the same instants (t0 and the period τ must agree to half a step, \
+         {half_step} s)"
+    )]
+    Instants {
+        run: String,
+        k: u32,
+        run_time: f64,
+        recording: String,
+        time: f64,
+        half_step: f64,
+    },
+}
+
+impl CompareError {
+    /// Whether the inputs are at fault (exit code 2), not the machine.
+    pub fn is_bad_input(&self) -> bool {
+        match self {
+            CompareError::Format(e) => e.is_bad_input(),
+            _ => true,
+        }
+    }
+}
+
+type Result<T, E = CompareError> = std::result::Result<T, E>;
+
 /// The second field's snapshots in index order, one at a time.
 type SnapshotStream<'a> = Box<dyn Iterator<Item = Result<Snapshot>> + 'a>;
 
 /// The initially hot and cold particles of a run (`None`: a uniform start).
 type HotCold = Option<(Vec<u32>, Vec<u32>)>;
 
-/// The inputs cannot be compared (exit code 2, like any bad input).
-macro_rules! refuse {
-    ($($arg:tt)*) => {
-        return Err(UsageError(format!($($arg)*)).into())
-    };
-}
-
-pub fn run(plan: &ComparePlan) -> Result<()> {
-    let recording = match RecordingReader::open(&plan.recording) {
-        Ok(r) => r,
-        // an extrapolation given first: the arguments are the wrong way round
-        Err(FormatError::NotRecording { .. })
-            if ExtrapolationReader::open(&plan.recording).is_ok() =>
-        {
-            refuse!(
-                "{} is not a tdex recording but an extrapolation: the arguments are the \
-                 wrong way round, the recording comes first (tdex compare RUN.mcap EXTRA.mcap)",
-                plan.recording.display()
-            );
-        }
-        Err(e) => return Err(e.into()),
-    };
-    // A file without recording metadata is read as an extrapolation, whose reader then
-    // names what is missing; any other fault of a recording is reported as it is.
-    let dem_runs = open_dem_runs(&plan.dem_runs)?;
-    let dem_runs: Vec<&RecordingReader> = dem_runs.iter().collect();
-    let c = match RecordingReader::open(&plan.extrapolation) {
-        Ok(dem) => compare_runs(
-            &recording,
-            Second::Dem(&dem),
-            &dem_runs,
-            plan.cells,
-            plan.seed,
-        )?,
-        Err(FormatError::NotRecording { .. }) => {
-            let extrapolation = ExtrapolationReader::open(&plan.extrapolation)?;
-            compare_runs(
-                &recording,
-                Second::Extrapolation(&extrapolation),
-                &dem_runs,
-                plan.cells,
-                plan.seed,
-            )?
-        }
-        Err(e) => return Err(e.into()),
-    };
-    if plan.json {
-        println!("{}", serde_json::to_string_pretty(&c)?);
-    } else if plan.csv {
-        print!("{}", csv(&c));
-    } else {
-        print!("{}", table(&c));
-    }
-    Ok(())
-}
-
 /// The further DEM runs given with `--dem-run`, opened as recordings.
-pub fn open_dem_runs(paths: &[std::path::PathBuf]) -> Result<Vec<RecordingReader>> {
-    Ok(paths
-        .iter()
-        .map(|p| RecordingReader::open(p))
-        .collect::<Result<Vec<_>, _>>()?)
+pub fn open_dem_runs(paths: &[std::path::PathBuf]) -> Result<Vec<RecordingReader>, FormatError> {
+    paths.iter().map(|p| RecordingReader::open(p)).collect()
 }
 
 /// Compares `extrapolation` with the DEM reference snapshots of `recording`.
@@ -259,17 +270,17 @@ pub fn compare_runs(
         Second::Extrapolation(extrapolation) => {
             let extra_path = extrapolation.path().display().to_string();
             if extrapolation.info().recording_info != *recording.info() {
-                refuse!(
-                    "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
-                     recordings' metadata differ)",
-                    extrapolation.info().recording
-                );
+                return Err(CompareError::OtherRecording {
+                    extrapolation: extra_path,
+                    recording: rec_path,
+                    names: extrapolation.info().recording.clone(),
+                });
             }
             // streamed: an extrapolation of hundreds of periods is never held whole
             let snaps: SnapshotStream = Box::new(
                 extrapolation
                     .snapshots_in_order()
-                    .map(|s| s.map_err(anyhow::Error::from)),
+                    .map(|s| s.map_err(CompareError::from)),
             );
             (extra_path, snaps, SecondKind::Extrapolation, None)
         }
@@ -291,21 +302,23 @@ pub fn compare_runs(
         }
     };
     let dem_at = |k: u32| dem.iter().find(|s| s.index == k);
-    let t0 = dem_at(0).with_context(|| format!("{rec_path}: no snapshot at t0"))?;
-    let t1 = dem_at(1).with_context(|| format!("{rec_path}: no snapshot at t1"))?;
+    let missing = |index| CompareError::MissingSnapshot {
+        path: rec_path.clone(),
+        index,
+    };
+    let t0 = dem_at(0).ok_or_else(|| missing(0))?;
+    let t1 = dem_at(1).ok_or_else(|| missing(1))?;
     if dem.len() <= 2 {
-        refuse!(
-            "{rec_path} has no DEM reference after t1: record it with `--reference K` \
-             (K ≥ the periods to compare) to compare an extrapolation"
-        );
+        return Err(CompareError::NoReference { path: rec_path });
     }
     let reach = t1.radius.iter().copied().fold(0.0, f64::max);
     let cells_v = Cells::inside_bed(&t1.pos, reach, cells, seed);
     if cells_v.len() < cells {
-        refuse!(
-            "{rec_path}: only {} of {cells} Voronoi seeds could be drawn inside the bed at t1",
-            cells_v.len()
-        );
+        return Err(CompareError::TooFewSeeds {
+            path: rec_path,
+            drawn: cells_v.len(),
+            cells,
+        });
     }
     let groups = metrics::hot_cold_groups(&t0.temp);
     // An extrapolation's ids are the recording's particles; a second run has its own, and
@@ -390,7 +403,7 @@ pub fn compare_runs(
         };
         let extra_means = metrics::cell_means(extra_cells, &after.temp, cells_v.len());
         let (eps_abs, cells_used) = metrics::eps_abs(&dem_means, &extra_means)
-            .with_context(|| format!("t_{k}: no Voronoi cell holds particles of both fields"))?;
+            .ok_or(CompareError::NoSharedCell { k })?;
         let (hot_dem, cold_dem) = means(&dem_after.temp);
         let extra_after = by_id(after);
         let (hot_extra, cold_extra) = means_in(&extra_groups, &extra_after);
@@ -476,11 +489,11 @@ pub fn compare_runs(
         });
     }
     if periods.is_empty() {
-        refuse!(
-            "{extra_path} and {rec_path} share no extrapolated t_k: the recording's reference \
-             ends at t_{}",
-            dem.last().map_or(0, |s| s.index)
-        );
+        return Err(CompareError::NoSharedInstant {
+            second: extra_path,
+            recording: rec_path,
+            last: dem.last().map_or(0, |s| s.index),
+        });
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
@@ -514,23 +527,25 @@ fn check_same_instants(
     let twin_path = twin.path().display().to_string();
     let (n, n_twin) = (recording.info().particles, twin.info().particles);
     if n != n_twin {
-        refuse!(
-            "{twin_path} holds {n_twin} particles and {rec_path} {n}: two DEM runs are compared \
-             only with the same particle count"
-        );
+        return Err(CompareError::ParticleCount {
+            run: twin_path,
+            run_particles: n_twin,
+            recording: rec_path,
+            particles: n,
+        });
     }
     let half_step = 0.5 * recording.info().dt;
     for s in twin_snaps {
         if let Some(d) = dem.iter().find(|d| d.index == s.index) {
             if (d.time - s.time).abs() > half_step {
-                refuse!(
-                    "{twin_path}: its t_{k} is at {} s and {rec_path}'s at {} s; two DEM runs \
-                     are compared at the same instants (t0 and the period τ must agree to half \
-                     a step, {half_step} s)",
-                    s.time,
-                    d.time,
-                    k = s.index
-                );
+                return Err(CompareError::Instants {
+                    run: twin_path,
+                    k: s.index,
+                    run_time: s.time,
+                    recording: rec_path,
+                    time: d.time,
+                    half_step,
+                });
             }
         }
     }

@@ -2,7 +2,7 @@
 //! extrapolated and compared with the DEM reference; the study writes a grid on
 //! the terminal (or JSON), `study.json`, `study.md` and SVG plots into its directory.
 
-pub mod flow;
+pub use tdex::flow;
 mod period;
 mod plots;
 mod regimes;

@@ -3,7 +3,7 @@
 //! the active-layer thickness and the motion relative to solid-body rotation. Pure functions
 //! of the case and one snapshot; the drum turns about +y (z → x), gravity is −z.
 
-use recorder::format::Snapshot;
+use tdex_format::Snapshot;
 use recorder::simulation::GRAVITY;
 use recorder::Case;
 use serde::Serialize;
