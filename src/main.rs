@@ -65,6 +65,8 @@ fn main() -> ExitCode {
                     || e.is::<cli::UsageError>()
                     || e.is::<extrapolate::replay::ReplayError>()
                     || e.is::<extrapolate::pairing::PairingError>()
+                    || e.downcast_ref::<extrapolate::ExtrapolateError>()
+                        .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::format::FormatError>()
                         .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::import::ImportError>()
