@@ -2,10 +2,11 @@
 //! revolution with a six-period DEM reference and one DEM twin (the DEM's own spread),
 //! extrapolate six periods, compare, report, and say how far to trust the prediction.
 
-use crate::cli::{DemoPlan, ExtrapolatePlan, RecordPlan, RecordStart};
+use crate::cli::{DemoPlan, RecordPlan, RecordStart};
 use crate::{compare, extrapolation, record, report};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
+use extrapolate::{ExtrapolationRequest, TableChoice};
 use recorder::format::{ExtrapolationReader, RecordingReader};
 
 /// The built-in case (the same text as `cases/small_drum.toml`).
@@ -50,17 +51,22 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
     })?;
 
     println!("2/4 extrapolate {PERIODS} periods (pairing, then the explicit replay)");
-    extrapolation::run(&ExtrapolatePlan {
-        file: recording.clone(),
+    let request = ExtrapolationRequest {
+        recording: recording.clone(),
         periods: PERIODS,
         output: extra.clone(),
         scheme: Scheme::Explicit,
-        stream: false,
+        table: TableChoice::InMemoryIfItFits,
         max_memory: None,
-        threads: plan.threads,
         reproducible: false,
-        json: false,
+    };
+    let outcome = crate::with_workers(plan.threads, || {
+        Ok(extrapolate::extrapolate_recording(
+            &request,
+            extrapolation::tell,
+        )?)
     })?;
+    extrapolation::print(&request, outcome, false)?;
 
     println!("3/4 compare   against the DEM reference and its twin");
     let rec = RecordingReader::open(&recording)?;

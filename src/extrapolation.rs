@@ -1,22 +1,18 @@
-//! `tdex extrapolate`: K periods of the recorded table replayed through the pairing.
+//! `tdex extrapolate`: K periods of the recorded table replayed through the pairing
+//! ([`extrapolate::extrapolate_recording`]), told on the terminal.
 
 use crate::cli::ExtrapolatePlan;
-use crate::pair;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use extrapolate::replay::memory::human_bytes;
-use extrapolate::replay::{
-    self, Bodies, Exchange, MemoryNeeds, MemoryPlan, ModeReason, Scheme, SyncScratch, Table,
-    TableMode,
-};
-use recorder::format::{
-    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingReader, FORMAT_VERSION,
-};
+use extrapolate::replay::{self, MemoryPlan, ModeReason, TableMode};
+use extrapolate::sidecar::PairingSummary;
+use extrapolate::{ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice};
+use recorder::format::ExtrapolationCosts;
 use serde::Serialize;
-use std::time::Instant;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
 #[derive(Debug, Serialize)]
-pub struct ExtrapolationReport {
+struct ExtrapolationReport {
     output: String,
     scheme: String,
     periods: u32,
@@ -25,170 +21,60 @@ pub struct ExtrapolationReport {
     max_cfl: f64,
     table_in_memory: bool,
     memory: MemoryReport,
-    pairing: pair::PairingSummary,
+    pairing: PairingSummary,
     costs: ExtrapolationCosts,
     total_heat_t1: f64,
     total_heat_end: f64,
 }
 
-pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
-    let report = crate::with_workers(plan.threads, || extrapolate(plan))?;
-    print(&report, plan.json)
+impl ExtrapolationReport {
+    fn of(request: &ExtrapolationRequest, outcome: ExtrapolationOutcome) -> Self {
+        Self {
+            output: request.output.display().to_string(),
+            scheme: request.scheme.name().into(),
+            periods: request.periods,
+            particles: outcome.particles,
+            rows: outcome.rows,
+            max_cfl: outcome.max_cfl,
+            table_in_memory: outcome.memory.mode == TableMode::InMemory,
+            memory: MemoryReport::of(&outcome.memory, &outcome.limit),
+            pairing: outcome.pairing,
+            costs: outcome.costs,
+            total_heat_t1: outcome.total_heat_t1,
+            total_heat_end: outcome.total_heat_end,
+        }
+    }
 }
 
-/// Pairs (or reuses the stored pairing), replays and writes the extrapolation; prints
-/// nothing. Runs on the current worker pool.
-pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
-    let reader = RecordingReader::open(&plan.file)?;
-    let info = reader.info().clone();
-    let (t0, t1) = pair::period_snapshots(&reader)?;
-    let bodies = Bodies::of(&info, &t0);
-    let stored_pairing = pair::load(&reader, &t0, &t1);
-
-    // the memory it will need, stated and held against the limit before the pairing and
-    // the replay start: a table that does not fit is streamed, never left to the OOM killer
-    let limit = match plan.max_memory {
-        Some(bytes) => MemoryLimit {
-            bytes,
-            source: "--max-memory".into(),
-        },
-        None => MemoryLimit::available(),
-    };
-    let needs = MemoryNeeds::estimate(
-        info.particles as u64,
-        reader.table_rows(),
-        reader.largest_table_chunk(),
-        stored_pairing.is_some(),
-    );
-    let memory = MemoryPlan::choose(needs, limit.bytes, &limit.source, plan.stream)
-        .with_context(|| format!("{}", plan.file.display()))?;
-    eprintln!("{}", memory_statement(&memory, &limit));
-
-    let started = Instant::now();
-    let (stored, reused) = match stored_pairing {
-        Some(stored) => (stored, true),
-        None => {
-            let mut stored = pair::compute(&t0, &t1)?;
-            if plan.reproducible {
-                stored.summary = stored.summary.reproducible();
-            }
-            // the stored pairing only saves time next run: a recording on a full or read-only
-            // disk is still extrapolated
-            if let Err(e) = pair::store(&reader, &stored) {
-                eprintln!("warning: {e:#}; the pairing will be computed again next time");
-            }
-            (stored, false)
-        }
-    };
-    let seconds_pairing = if reused {
-        0.0
-    } else {
-        started.elapsed().as_secs_f64()
-    };
-
-    // the table: decoded once into memory, or streamed from the file each period
-    let t = Instant::now();
-    let (table, rows, worst) = if memory.mode == TableMode::Streamed {
-        let found = replay::scan(&reader, &bodies, |_, _| {})?;
-        (None, found.rows, found.worst)
-    } else {
-        let (table, worst) = Table::read(&reader, &bodies)?;
-        let rows = table.exchanges.len() as u64;
-        (Some(table), rows, worst)
-    };
-    let seconds_read_table = t.elapsed().as_secs_f64();
-    let max_cfl = worst.map_or(0.0, |w| w.cfl);
-    if let Some(w) = worst.filter(|w| plan.scheme == Scheme::Explicit && w.cfl >= 1.0) {
-        return Err(w.refusal()).with_context(|| format!("{}", plan.file.display()));
-    }
-
-    let out_info = ExtrapolationInfo {
-        format_version: FORMAT_VERSION,
-        tool_version: env!("CARGO_PKG_VERSION").into(),
-        recording: plan.file.display().to_string(),
-        recording_info: info.clone(),
+pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
+    let request = ExtrapolationRequest {
+        recording: plan.file.clone(),
+        periods: plan.periods,
+        output: plan.output.clone(),
         scheme: plan.scheme,
-        periods: plan.periods,
-        pairing: if plan.reproducible {
-            // a stored pairing made without --reproducible carries its time
-            stored.summary.clone().reproducible()
+        table: if plan.stream {
+            TableChoice::Streamed
         } else {
-            stored.summary.clone()
+            TableChoice::InMemoryIfItFits
         },
+        max_memory: plan.max_memory,
+        reproducible: plan.reproducible,
     };
-    let mut writer = ExtrapolationWriter::create(&plan.output, &out_info)?;
-    writer.write_snapshot(&t1)?;
+    let outcome = crate::with_workers(plan.threads, || {
+        Ok(extrapolate::extrapolate_recording(&request, tell)?)
+    })?;
+    print(&request, outcome, plan.json)
+}
 
-    // role a ends each period at x_a(t1): the snapshot's positions, radii and velocities
-    let mut temps = t1.temp.clone();
-    let heat_t1 = replay::total_heat(&temps, &bodies);
-    let mut next = Vec::with_capacity(temps.len());
-    let mut scratch = SyncScratch::default();
-    let mut exchanges: Vec<Exchange> = Vec::new();
-    // the output snapshot: t1's positions, radii and velocities, the extrapolated
-    // temperatures, and as `id` the particle that plays each role (it moves with its heat)
-    let mut out = t1;
-    let mut next_id = Vec::with_capacity(out.id.len());
-    let t = Instant::now();
-    for k in 1..=plan.periods {
-        replay::move_to_roles(&temps, &stored.g, &mut next)?;
-        std::mem::swap(&mut temps, &mut next);
-        replay::move_to_roles(&out.id, &stored.g, &mut next_id)?;
-        std::mem::swap(&mut out.id, &mut next_id);
-        match &table {
-            Some(table) => replay::apply_rows_with(
-                &mut temps,
-                &table.exchanges,
-                &bodies,
-                plan.scheme,
-                &mut scratch,
-            ),
-            None => {
-                for batch in reader.table() {
-                    exchanges.clear();
-                    exchanges.extend(batch?.rows.iter().map(|r| Exchange::of(r, &info)));
-                    replay::apply_rows_with(
-                        &mut temps,
-                        &exchanges,
-                        &bodies,
-                        plan.scheme,
-                        &mut scratch,
-                    );
-                }
-            }
+/// Tells an extrapolation's [`Notice`] on stderr: the memory plan before any work, a
+/// pairing that could not be stored.
+pub fn tell(notice: Notice<'_>) {
+    match notice {
+        Notice::Memory { plan, limit } => eprintln!("{}", memory_statement(plan, limit)),
+        Notice::PairingNotStored(e) => {
+            eprintln!("warning: {e}; the pairing will be computed again next time")
         }
-        scratch.flush(&mut temps);
-        out.index = k + 1;
-        out.time = info.snapshot_time(k + 1);
-        out.temp.copy_from_slice(&temps);
-        writer.write_snapshot(&out)?;
     }
-    let seconds_replay = t.elapsed().as_secs_f64();
-    let costs = ExtrapolationCosts {
-        seconds_pairing,
-        pairing_reused: reused,
-        seconds_read_table,
-        seconds_replay,
-        seconds_per_period: seconds_replay / plan.periods as f64,
-        rows_per_second: rows as f64 * plan.periods as f64 / seconds_replay.max(1e-12),
-        rows,
-    };
-    writer.finish((!plan.reproducible).then_some(&costs))?;
-    let report = ExtrapolationReport {
-        output: plan.output.display().to_string(),
-        scheme: plan.scheme.name().into(),
-        periods: plan.periods,
-        particles: info.particles,
-        rows,
-        max_cfl,
-        table_in_memory: table.is_some(),
-        memory: MemoryReport::of(&memory, &limit),
-        pairing: stored.summary.clone(),
-        costs,
-        total_heat_t1: heat_t1,
-        total_heat_end: replay::total_heat(&temps, &bodies),
-    };
-    Ok(report)
 }
 
 /// Rows a second that decoding the table costs, each period, when it is streamed: the
@@ -196,74 +82,13 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
 /// 0.101 s in memory (docs/benchmarks.md), 0.92 s to decode them.
 const STREAM_DECODE_ROWS_PER_SECOND: f64 = 2.5e7;
 
-/// The memory an extrapolation may use, and where that figure came from.
-pub struct MemoryLimit {
-    pub bytes: u64,
-    pub source: String,
-}
-
-impl MemoryLimit {
-    /// The default: 80 % of what the machine can still give (`MemAvailable` in
-    /// /proc/meminfo) and of what the process's cgroup still allows (`memory.max` −
-    /// `memory.current`, cgroup v2), whichever is smaller. The 20 % left is for the page
-    /// cache holding the recording and for the rest of the machine. Without /proc/meminfo
-    /// there is no limit (the table is held in memory, as before `--max-memory`).
-    pub fn available() -> Self {
-        let mut found: Vec<(u64, &str)> = Vec::new();
-        if let Some(kb) = std::fs::read_to_string("/proc/meminfo")
-            .ok()
-            .and_then(|text| meminfo_kb(&text, "MemAvailable:"))
-        {
-            found.push((kb.saturating_mul(1024), "MemAvailable"));
-        }
-        if let Some(room) = cgroup_room() {
-            found.push((room, "the cgroup's memory.max"));
-        }
-        match found.into_iter().min() {
-            Some((bytes, what)) => Self {
-                bytes: bytes / 5 * 4,
-                source: format!("80 % of {what}; set it with --max-memory"),
-            },
-            None => Self {
-                bytes: u64::MAX,
-                source: "no limit known: no /proc/meminfo; set one with --max-memory".into(),
-            },
-        }
-    }
-}
-
-/// A `Key:   123 kB` line of /proc/meminfo, in kB.
-fn meminfo_kb(text: &str, key: &str) -> Option<u64> {
-    text.lines()
-        .find_map(|l| l.strip_prefix(key))
-        .and_then(|rest| rest.split_whitespace().next())
-        .and_then(|v| v.parse().ok())
-}
-
-/// What the process's cgroup (v2) still allows, if it sets a limit.
-fn cgroup_room() -> Option<u64> {
-    let own = std::fs::read_to_string("/proc/self/cgroup").ok()?;
-    let path = own.lines().find_map(|l| l.strip_prefix("0::"))?;
-    let dir = std::path::Path::new("/sys/fs/cgroup").join(path.trim_start_matches('/'));
-    let read = |name: &str| -> Option<u64> {
-        std::fs::read_to_string(dir.join(name))
-            .ok()?
-            .trim()
-            .parse()
-            .ok()
-    };
-    // "max" (no limit) does not parse
-    let max = read("memory.max")?;
-    Some(max.saturating_sub(read("memory.current").unwrap_or(0)))
-}
-
 /// The line stated before any work: what the replay needs, the limit, where the table goes.
 fn memory_statement(memory: &MemoryPlan, limit: &MemoryLimit) -> String {
     let n = &memory.needs;
-    let limit_text = if limit.bytes == u64::MAX {
-        format!("no limit ({})", limit.source)
-    } else {
+    let limit_text = if limit.is_known() {
         format!("limit {} ({})", human_bytes(limit.bytes), limit.source)
+    } else {
+        format!("no limit ({})", limit.source)
     };
     let parts = format!(
         "table {} ({} rows × {} B), particles {}, pairing {}, buffers {}",
@@ -321,7 +146,7 @@ impl MemoryReport {
     fn of(memory: &MemoryPlan, limit: &MemoryLimit) -> Self {
         let n = &memory.needs;
         Self {
-            limit_bytes: (limit.bytes != u64::MAX).then_some(limit.bytes),
+            limit_bytes: limit.is_known().then_some(limit.bytes),
             limit_source: limit.source.clone(),
             table: match memory.mode {
                 TableMode::InMemory => "in_memory",
@@ -343,7 +168,13 @@ impl MemoryReport {
     }
 }
 
-fn print(report: &ExtrapolationReport, json: bool) -> Result<()> {
+/// Prints the extrapolation's summary, or its JSON (`--json`).
+pub fn print(
+    request: &ExtrapolationRequest,
+    outcome: ExtrapolationOutcome,
+    json: bool,
+) -> Result<()> {
+    let report = &ExtrapolationReport::of(request, outcome);
     if json {
         println!("{}", serde_json::to_string_pretty(report)?);
     } else {

@@ -3,10 +3,10 @@
 //! the active-layer thickness and the motion relative to solid-body rotation. Pure functions
 //! of the case and one snapshot; the drum turns about +y (z → x), gravity is −z.
 
-use tdex_format::Snapshot;
 use recorder::simulation::GRAVITY;
 use recorder::Case;
 use serde::Serialize;
+use tdex_format::Snapshot;
 
 /// Default `--min-relative`: below this mean speed relative to solid-body rotation (as a
 /// fraction of the wall speed ωR) the bed is taken to move with the drum.

@@ -68,6 +68,8 @@ fn main() -> ExitCode {
                     || e.is::<extrapolate::pairing::PairingError>()
                     || e.downcast_ref::<compare::CompareError>()
                         .is_some_and(|f| f.is_bad_input())
+                    || e.downcast_ref::<extrapolate::ExtrapolateError>()
+                        .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::format::FormatError>()
                         .is_some_and(|f| f.is_bad_input())
                     || e.downcast_ref::<recorder::import::ImportError>()

@@ -172,16 +172,28 @@ fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_cou
     std::fs::write(&case, TINY_CASE).unwrap();
     let run = dir.path().join("run.mcap");
     let run_s = run.to_str().unwrap();
-    tdex_ok(&["record", case.to_str().unwrap(), "-o", run_s, "--reproducible"]);
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        run_s,
+        "--reproducible",
+    ]);
     let sidecar = dir.path().join("run.mcap.pairing.json");
     let mut pairings = Vec::new();
     for threads in ["1", "2"] {
         tdex_ok(&["pair", run_s, "--threads", threads, "--reproducible"]);
         pairings.push(std::fs::read(&sidecar).unwrap());
     }
-    assert!(pairings[0] == pairings[1], "the sidecar depends on the threads");
+    assert!(
+        pairings[0] == pairings[1],
+        "the sidecar depends on the threads"
+    );
     let text = String::from_utf8_lossy(&pairings[0]);
-    assert!(!text.contains("seconds") && !text.contains("threads"), "{text}");
+    assert!(
+        !text.contains("seconds") && !text.contains("threads"),
+        "{text}"
+    );
 
     // the extrapolation computes its own pairing (no sidecar) on each thread count
     let mut files = Vec::new();
@@ -195,7 +207,10 @@ fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_cou
         ));
         files.push(std::fs::read(&out).unwrap());
     }
-    assert!(files[0] == files[1], "the extrapolation depends on the threads");
+    assert!(
+        files[0] == files[1],
+        "the extrapolation depends on the threads"
+    );
     let costs = b"tdex.extrapolation_costs";
     assert!(!files[0].windows(costs.len()).any(|w| w == costs));
     // without the flag the file holds the costs record

@@ -1,8 +1,18 @@
 //! Pairing of the t0/t1 snapshots and replay of a recorded collision table (docs/method.md §5–6;
 //! issue 4): [`pairing`] finds the roles, [`replay`] applies the table period after period,
-//! [`sidecar`] stores the pairing beside the recording.
+//! [`sidecar`] stores the pairing beside the recording and [`cache`] reuses it;
+//! [`extrapolate_recording`] extrapolates a recording with them.
 
+pub mod cache;
+mod driver;
+mod error;
 pub mod pairing;
 pub mod replay;
 
+pub use driver::{
+    extrapolate_recording, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice,
+    TableChoice,
+};
+pub use error::ExtrapolateError;
+/// The pairing sidecar's format lives with the other files in `tdex-format`.
 pub use tdex_format::sidecar;

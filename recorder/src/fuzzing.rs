@@ -1,9 +1,9 @@
 //! Every fuzz target's entry point in one place, for the fuzz targets (`fuzz/`) and the corpus test (`tests/fuzz_corpus.rs`): bytes in, `Ok` or an error naming the file, never a panic. The case and dump readers are here, the file readers in [`tdex_format::fuzzing`].
 
 use crate::case::CaseError;
-use tdex_format::fuzzing::{extrapolation, pairing, recording, SIDECAR_NAME};
 use crate::import::{liggghts, ImportError};
 use std::path::Path;
+use tdex_format::fuzzing::{extrapolation, pairing, recording, SIDECAR_NAME};
 
 pub use tdex_format::fuzzing::MCAP_NAME;
 

@@ -28,7 +28,7 @@ pub mod slices;
 pub mod wall;
 
 pub use case::{Case, CaseError};
+pub use simulation::{Simulation, SimulationError};
 /// The file contract lives in its own crate (`recorder/format`); these paths keep reading
 /// as before for the engine's own modules.
 pub use tdex_format::{self as format, output};
-pub use simulation::{Simulation, SimulationError};

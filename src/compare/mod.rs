@@ -8,8 +8,8 @@ pub mod verdict;
 
 use floor::Field;
 use metrics::Cells;
-use tdex_format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 use serde::Serialize;
+use tdex_format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 pub use verdict::Verdict;
 
 /// Default number of Voronoi cells (the paper's v = 200).
@@ -402,8 +402,8 @@ pub fn compare_runs(
             }
         };
         let extra_means = metrics::cell_means(extra_cells, &after.temp, cells_v.len());
-        let (eps_abs, cells_used) = metrics::eps_abs(&dem_means, &extra_means)
-            .ok_or(CompareError::NoSharedCell { k })?;
+        let (eps_abs, cells_used) =
+            metrics::eps_abs(&dem_means, &extra_means).ok_or(CompareError::NoSharedCell { k })?;
         let (hot_dem, cold_dem) = means(&dem_after.temp);
         let extra_after = by_id(after);
         let (hot_extra, cold_extra) = means_in(&extra_groups, &extra_after);

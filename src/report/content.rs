@@ -370,7 +370,10 @@ pub fn document(inp: &Inputs) -> Document {
                     None => "adiabatic".into(),
                 },
             ),
-            row("Extrapolation scheme", inp.extrapolation.scheme.name().into()),
+            row(
+                "Extrapolation scheme",
+                inp.extrapolation.scheme.name().into(),
+            ),
             row(
                 "Extrapolated periods",
                 format!("{periods} ({})", span(periods + 1)),

@@ -8,11 +8,12 @@ mod plots;
 mod regimes;
 mod sampling;
 
-use crate::cli::{ExtrapolatePlan, StudyKind, StudyPlan};
+use crate::cli::{StudyKind, StudyPlan};
 use crate::compare::{self, Comparison};
 use crate::extrapolation;
 use anyhow::Result;
 use extrapolate::replay::Scheme;
+use extrapolate::{ExtrapolationRequest, TableChoice};
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
 use recorder::format::{ExtrapolationReader, RecordingReader};
@@ -88,8 +89,8 @@ impl Outcome {
     }
 }
 
-/// Extrapolates `recording` over `periods` into `extra` with `tdex extrapolate` (a child
-/// process of this executable) and compares it with the DEM reference.
+/// Extrapolates `recording` over `periods` into `extra` (the explicit scheme, on `threads`
+/// workers) and compares it with the DEM reference.
 pub fn evaluate(
     recording: &Path,
     extra: &Path,
@@ -98,18 +99,21 @@ pub fn evaluate(
     cells: usize,
 ) -> Result<Outcome> {
     let rec = RecordingReader::open(recording)?;
-    let plan = ExtrapolatePlan {
-        file: recording.to_path_buf(),
+    let request = ExtrapolationRequest {
+        recording: recording.to_path_buf(),
         periods,
         output: extra.to_path_buf(),
         scheme: Scheme::Explicit,
-        stream: false,
+        table: TableChoice::InMemoryIfItFits,
         max_memory: None,
-        threads,
         reproducible: false,
-        json: true,
     };
-    if let Err(e) = crate::with_workers(threads, || extrapolation::extrapolate(&plan)) {
+    if let Err(e) = crate::with_workers(threads, || {
+        Ok(extrapolate::extrapolate_recording(
+            &request,
+            extrapolation::tell,
+        )?)
+    }) {
         // a refused extrapolation (e.g. the explicit scheme's CFL guard) is a study result
         return Ok(Outcome::table_only(&rec, format!("{e:#}")));
     }

@@ -1,8 +1,8 @@
 //! The table in the replay's compact form: each row as its two bodies, its start and the
 //! heat it can carry per kelvin, `H·m` (J/K); 24 bytes a row.
 
-use tdex_format::{FormatError, RecordingInfo, RecordingReader, Snapshot};
 use tdex_format::CollisionRow;
+use tdex_format::{FormatError, RecordingInfo, RecordingReader, Snapshot};
 
 /// One row ready to apply.
 #[derive(Debug, Clone, Copy, PartialEq)]

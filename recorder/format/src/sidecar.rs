@@ -33,7 +33,8 @@ impl PairingSummary {
 /// The stored pairing: `g[p]` = the role particle `p` takes in the next period.
 #[derive(Debug, Serialize, Deserialize)]
 pub struct StoredPairing {
-    /// Fingerprint of the snapshots it pairs: reused only for the same positions.
+    /// Fingerprint of the snapshots it pairs (`extrapolate::cache::fingerprint`, a hash whose algorithm is fixed): reused only for
+    /// the same positions.
     pub snapshots_fingerprint: u64,
     pub summary: PairingSummary,
     pub g: Vec<u32>,

@@ -1,0 +1,115 @@
+//! The pairing cache: the pairing of a recording's `t0` and `t1` snapshots, computed once and
+//! stored beside the recording ([`sidecar`](crate::sidecar)), reused while the snapshots'
+//! positions are the ones it was computed for.
+
+use crate::pairing::{self, PairingOptions};
+use crate::sidecar::{self, PairingSummary, StoredPairing};
+use crate::ExtrapolateError;
+use std::hash::Hasher;
+use std::path::PathBuf;
+use tdex_format::{RecordingReader, Snapshot};
+
+/// The snapshots at `t0` and `t1` that bound the recorded period.
+pub fn period_snapshots(
+    reader: &RecordingReader,
+) -> Result<(Snapshot, Snapshot), ExtrapolateError> {
+    let snapshot = |index| {
+        reader
+            .snapshot(index)?
+            .ok_or(ExtrapolateError::MissingSnapshot { index })
+    };
+    Ok((snapshot(0)?, snapshot(1)?))
+}
+
+/// A hash of the positions at `t0` and `t1`, the pairing's only input: a stored pairing
+/// is reused for these snapshots and no others (a recording made again with another case
+/// or seed into the same file name has other positions).
+///
+/// The key is on disk, so its algorithm must not change with the compiler: SipHash-1-3 with
+/// zero keys from the `siphasher` crate, fed per point the length 3 as a little-endian u64
+/// and the three coordinates' bits, little-endian — the byte stream that std's
+/// `DefaultHasher` (SipHash-1-3 with zero keys today, without a promise) was fed by
+/// `[u64; 3]::hash` on the 64-bit little-endian machines tdex runs on, so the sidecars
+/// written before keep their key.
+pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
+    let mut h = siphasher::sip::SipHasher13::new_with_keys(0, 0);
+    for p in t0.pos.iter().chain(&t1.pos) {
+        h.write(&(p.len() as u64).to_le_bytes());
+        for x in p {
+            h.write(&x.to_bits().to_le_bytes());
+        }
+    }
+    h.finish()
+}
+
+/// Computes the pairing of the recording's snapshots at `t0` and `t1` on the current
+/// worker pool; its summary carries the solve's time and thread count.
+pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, ExtrapolateError> {
+    let d = t0.mean_diameter();
+    let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
+    Ok(StoredPairing {
+        snapshots_fingerprint: fingerprint(t0, t1),
+        summary: PairingSummary {
+            particles: p.g.len(),
+            diameter: d,
+            total_distance_diameters: p.total_distance / d,
+            mean_distance_diameters: p.mean_distance_in_diameters(d),
+            k_used: p.k_used,
+            certified: p.certified,
+            rounds: p.rounds,
+            seconds: Some(p.seconds),
+            threads: Some(rayon::current_num_threads()),
+        },
+        g: p.g,
+    })
+}
+
+/// The stored pairing of this recording's snapshots `t0` and `t1`, if one matches them (a
+/// missing, unreadable or malformed sidecar is computed again).
+pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<StoredPairing> {
+    let n = reader.info().particles as usize;
+    let stored = sidecar::read(&sidecar::path_of(reader.path()), n).ok()??;
+    (stored.snapshots_fingerprint == fingerprint(t0, t1)).then_some(stored)
+}
+
+/// Writes the pairing beside the recording (temporary file, fsync, rename); returns the
+/// sidecar's path.
+pub fn store(
+    reader: &RecordingReader,
+    stored: &StoredPairing,
+) -> Result<PathBuf, ExtrapolateError> {
+    let path = sidecar::path_of(reader.path());
+    Ok(tdex_format::output::write_atomically(
+        &path,
+        &serde_json::to_vec(stored)?,
+    )?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn snapshot(pos: Vec<[f64; 3]>) -> Snapshot {
+        let n = pos.len();
+        Snapshot {
+            index: 0,
+            time: 0.0,
+            id: (0..n as u32).collect(),
+            pos,
+            radius: vec![0.005; n],
+            vel: vec![[0.0; 3]; n],
+            temp: vec![300.0; n],
+        }
+    }
+
+    /// The cache key is on disk: a change of algorithm (or of the bytes fed to it) would
+    /// silently make every stored pairing stale, so its value is pinned. The literal is also
+    /// what std's `DefaultHasher` gave for these positions (Rust 1.95), the key of the
+    /// sidecars written before the cache moved to `siphasher`.
+    #[test]
+    fn the_fingerprint_of_fixed_positions_is_pinned() {
+        let t0 = snapshot(vec![[0.0, 0.5, -1.0], [1.0e-3, 2.0, 3.25]]);
+        let t1 = snapshot(vec![[1.0e-3, 2.0, 3.25], [f64::MAX, -0.0, 7.0]]);
+        assert_eq!(fingerprint(&t0, &t1), 15_178_127_322_323_436_536);
+    }
+}
