@@ -60,8 +60,11 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
         reader.largest_table_chunk(),
         stored_pairing.is_some(),
     );
-    let memory = MemoryPlan::choose(needs, limit.bytes, &limit.source, plan.stream)
-        .with_context(|| format!("{}", plan.file.display()))?;
+    let memory =
+        MemoryPlan::choose(needs, limit.bytes, &limit.source, plan.stream).with_context(|| {
+            let file = plan.file.display();
+            format!("{file}: allow more with --max-memory or free memory")
+        })?;
     eprintln!("{}", memory_statement(&memory, &limit));
 
     let started = Instant::now();
@@ -99,7 +102,10 @@ pub fn extrapolate(plan: &ExtrapolatePlan) -> Result<ExtrapolationReport> {
     let seconds_read_table = t.elapsed().as_secs_f64();
     let max_cfl = worst.map_or(0.0, |w| w.cfl);
     if let Some(w) = worst.filter(|w| plan.scheme == Scheme::Explicit && w.cfl >= 1.0) {
-        return Err(w.refusal()).with_context(|| format!("{}", plan.file.display()));
+        return Err(w.refusal()).with_context(|| {
+            let file = plan.file.display();
+            format!("{file}: record with a smaller --dtc-max or replay with --scheme exact")
+        });
     }
 
     let out_info = ExtrapolationInfo {
