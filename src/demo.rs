@@ -57,7 +57,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         output: extra.clone(),
         scheme: Scheme::Explicit,
         table: TableChoice::InMemoryIfItFits,
-        max_memory: None,
+        memory_limit: extrapolation::memory_limit(None),
         reproducible: false,
     };
     let outcome = crate::with_workers(plan.threads, || {

@@ -4,9 +4,11 @@
 use crate::cli::ExtrapolatePlan;
 use anyhow::Result;
 use extrapolate::replay::memory::human_bytes;
-use extrapolate::replay::{self, MemoryPlan, ModeReason, TableMode};
+use extrapolate::replay::{self, MemoryPlan, ModeReason, ReplayError, TableMode};
 use extrapolate::sidecar::PairingSummary;
-use extrapolate::{ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice};
+use extrapolate::{
+    ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice,
+};
 use recorder::format::ExtrapolationCosts;
 use serde::Serialize;
 
@@ -57,13 +59,49 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         } else {
             TableChoice::InMemoryIfItFits
         },
-        max_memory: plan.max_memory,
+        memory_limit: memory_limit(plan.max_memory),
         reproducible: plan.reproducible,
     };
     let outcome = crate::with_workers(plan.threads, || {
-        Ok(extrapolate::extrapolate_recording(&request, tell)?)
+        extrapolate::extrapolate_recording(&request, tell).map_err(advice)
     })?;
     print(&request, outcome, plan.json)
+}
+
+/// The memory an extrapolation may use: `--max-memory` when given, else a share of what the
+/// machine has (and how to change it).
+pub fn memory_limit(max_memory: Option<u64>) -> MemoryLimit {
+    match max_memory {
+        Some(bytes) => MemoryLimit {
+            bytes,
+            source: "--max-memory".into(),
+        },
+        None => {
+            let mut limit = MemoryLimit::available();
+            let verb = if limit.is_known() { "set it" } else { "set one" };
+            limit.source = format!("{}; {verb} with --max-memory", limit.source);
+            limit
+        }
+    }
+}
+
+/// The library's refusal, with the flags that get past it.
+pub fn advice(e: ExtrapolateError) -> anyhow::Error {
+    match e {
+        ExtrapolateError::Refused { recording, error } => {
+            let advice = match &error {
+                ReplayError::Memory { .. } => "allow more with --max-memory or free memory",
+                ReplayError::Cfl { .. } => {
+                    "record with a smaller --dtc-max or replay with --scheme exact"
+                }
+                ReplayError::Roles { .. } => {
+                    return ExtrapolateError::Refused { recording, error }.into()
+                }
+            };
+            anyhow::Error::new(error).context(format!("{}: {advice}", recording.display()))
+        }
+        e => e.into(),
+    }
 }
 
 /// Tells an extrapolation's [`Notice`] on stderr: the memory plan before any work, a

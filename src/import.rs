@@ -2,8 +2,9 @@
 
 use crate::cli::ImportPlan;
 use crate::inspect::Sampling;
-use anyhow::{Context, Result};
+use anyhow::Result;
 use recorder::format::RecordingReader;
+use recorder::import::ImportError;
 use serde::Serialize;
 
 /// `tdex import liggghts --json` (keys documented in docs/user-guide.md).
@@ -33,11 +34,15 @@ pub fn run(plan: &ImportPlan) -> Result<()> {
         &plan.options,
         &plan.output,
     )
-    .with_context(|| {
-        format!(
-            "importing the LIGGGHTS dumps {} and {}",
-            plan.dumps.atoms, plan.dumps.contacts
-        )
+    .map_err(|e| {
+        let advice = match e {
+            ImportError::NoAtomDumpAtT1 { .. } => " (give --tau / --tau-rev for the period dumped)",
+            _ => "",
+        };
+        let (atoms, contacts) = (&plan.dumps.atoms, &plan.dumps.contacts);
+        anyhow::Error::new(e).context(format!(
+            "importing the LIGGGHTS dumps {atoms} and {contacts}{advice}"
+        ))
     })?;
     let reader = RecordingReader::open(&plan.output)?;
     let summary = ImportSummary {

@@ -22,8 +22,9 @@ pub struct ExtrapolationRequest {
     pub output: PathBuf,
     pub scheme: Scheme,
     pub table: TableChoice,
-    /// The memory the extrapolation may use, in bytes; `None`: [`MemoryLimit::available`].
-    pub max_memory: Option<u64>,
+    /// The memory the extrapolation may use (e.g. [`MemoryLimit::available`]): a table
+    /// that does not fit is streamed, and a replay that cannot fit even so is refused.
+    pub memory_limit: MemoryLimit,
     /// No times or thread counts in the sidecar or the extrapolation: the same inputs give
     /// the same bytes on any thread count.
     pub reproducible: bool,
@@ -87,13 +88,7 @@ pub fn extrapolate_recording(
 
     // the memory it will need, stated and held against the limit before the pairing and
     // the replay start: a table that does not fit is streamed, never left to the OOM killer
-    let limit = match request.max_memory {
-        Some(bytes) => MemoryLimit {
-            bytes,
-            source: "--max-memory".into(),
-        },
-        None => MemoryLimit::available(),
-    };
+    let limit = request.memory_limit.clone();
     let needs = MemoryNeeds::estimate(
         info.particles as u64,
         reader.table_rows(),
@@ -264,11 +259,11 @@ impl MemoryLimit {
         match found.into_iter().min() {
             Some((bytes, what)) => Self {
                 bytes: bytes / 5 * 4,
-                source: format!("80 % of {what}; set it with --max-memory"),
+                source: format!("80 % of {what}"),
             },
             None => Self {
                 bytes: u64::MAX,
-                source: "no limit known: no /proc/meminfo; set one with --max-memory".into(),
+                source: "no limit known: no /proc/meminfo".into(),
             },
         }
     }

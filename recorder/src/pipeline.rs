@@ -12,7 +12,7 @@ use crate::math::*;
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::prefetch::{self, ArrayAddress, Prefetch};
-use crate::slices::for_each_task;
+use crate::slices::{for_each_task, slices_indexed_alike, Pieces};
 use crate::wall::WallSet;
 use std::cell::RefCell;
 use std::ops::Range;
@@ -218,12 +218,23 @@ pub fn contact_interactions_in_chunks(
     // candidates of the layers it finishes (below), from the start of its pieces (which
     // reach the next task's start; it touches only those)
     let start = |l: usize| {
-        let s = layer_start[l] as usize;
-        let e = offsets[s] as usize;
-        let w = wall_offsets[s] as usize;
-        ((s, s), (s, ((e, e), (w, w))))
+        let slot = layer_start[l] as usize;
+        TaskStart {
+            slot,
+            pair_entry: offsets[slot] as usize,
+            wall_candidate: wall_offsets[slot] as usize,
+        }
     };
-    let layer_task = |l: usize, ((f, t), (q, ((h, touch), wall_pieces))): Accumulators| {
+    let layer_task = |l: usize, pieces: TaskPieces| {
+        let TaskPieces {
+            mut sums,
+            pairs:
+                ListPieces {
+                    histories: h,
+                    touching: touch,
+                },
+            walls: wall_pieces,
+        } = pieces;
         let first_slot = layer_start[l] as usize;
         let first_entry = offsets[first_slot] as usize;
         if l.is_multiple_of(2) {
@@ -231,9 +242,9 @@ pub fn contact_interactions_in_chunks(
             // zero here, where the task is about to use them, not in a pass of their own
             // over memory
             let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
-            f[..written].fill([0.0; 3]);
-            t[..written].fill([0.0; 3]);
-            q[..written].fill(0.0);
+            sums.force[..written].fill([0.0; 3]);
+            sums.torque[..written].fill([0.0; 3]);
+            sums.heat_flow[..written].fill(0.0);
         }
         let slots = first_slot..layer_start[l + 1] as usize;
         let layer_entries = offsets[slots.end] as usize - first_entry;
@@ -270,18 +281,18 @@ pub fn contact_interactions_in_chunks(
             };
             let mut evaluate = |batch: &mut PairBatch| {
                 batch.evaluate(&constants, &spheres, old, h);
-                owner.scatter(batch, (&mut *f, &mut *t, &mut *q), first_slot);
+                owner.scatter(batch, &mut sums, first_slot);
                 next.advance(owner.slots_done(first_slot) as f64 / owners);
             };
             let touching_pairs =
                 narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
             // the batch holds fewer than a full batch's contacts now: one evaluation
             evaluate(&mut batch);
-            owner.add_to((&mut *f, &mut *t, &mut *q), first_slot);
+            owner.add_to(&mut sums, first_slot);
             touching_pairs
         });
         let finished = finished_slots(l, layer_start);
-        let wall = wall_contacts.add(&spheres, finished, first_slot, (f, t, q), wall_pieces);
+        let wall = wall_contacts.add(&spheres, finished, first_slot, &mut sums, wall_pieces);
         ContactCount {
             pair_entries: 2 * pair_entries,
             wall,
@@ -289,20 +300,30 @@ pub fn contact_interactions_in_chunks(
     };
     // task k of a phase owns layer l = phase + 2k (its pieces reach the next task's start)
     let mut run = |phase: usize, tasks: Range<usize>| {
-        let arrays = (
-            (&mut force[..], &mut torque[..]),
-            (
-                &mut heat_flow[..],
-                (
-                    (&mut history[..], &mut touching[..]),
-                    (&mut wall_history[..], &mut wall_touching[..]),
-                ),
-            ),
-        );
-        let origin = ((0, 0), (0, ((0, 0), (0, 0))));
+        let arrays = TaskPieces {
+            sums: Sums {
+                force: &mut force[..],
+                torque: &mut torque[..],
+                heat_flow: &mut heat_flow[..],
+            },
+            pairs: ListPieces {
+                histories: &mut history[..],
+                touching: &mut touching[..],
+            },
+            walls: ListPieces {
+                histories: &mut wall_history[..],
+                touching: &mut wall_touching[..],
+            },
+        };
         let layer = |k: usize| phase + 2 * k;
-        let work = |k: usize, pieces: Accumulators| layer_task(layer(k), pieces);
-        for_each_task(arrays, origin, tasks, &|k| start(layer(k)), &work)
+        let work = |k: usize, pieces: TaskPieces| layer_task(layer(k), pieces);
+        for_each_task(
+            arrays,
+            TaskStart::default(),
+            tasks,
+            &|k| start(layer(k)),
+            &work,
+        )
     };
     // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
     // layer of each, and each particle's sums keep that order). Rather than all even
@@ -374,25 +395,20 @@ impl Owner {
     /// Adds an evaluated batch's responses to the owners' and partners' sums of a task's
     /// pieces starting at `first_slot`, and empties the batch.
     #[inline(always)]
-    fn scatter(
-        &mut self,
-        batch: &mut PairBatch,
-        (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]),
-        first_slot: usize,
-    ) {
+    fn scatter(&mut self, batch: &mut PairBatch, sums: &mut Sums, first_slot: usize) {
         for l in 0..batch.ready() {
             let (i, j, r) = batch.response(l);
             if i != self.slot {
-                self.add_to((&mut *f, &mut *t, &mut *q), first_slot);
+                self.add_to(sums, first_slot);
                 *self = Owner::new(i);
             }
             self.force = add(self.force, r.force);
             self.torque = add(self.torque, r.torque_owner);
             self.heat_flow += r.heat_flow;
             let jl = j - first_slot;
-            f[jl] = sub(f[jl], r.force);
-            t[jl] = add(t[jl], r.torque_partner);
-            q[jl] -= r.heat_flow;
+            sums.force[jl] = sub(sums.force[jl], r.force);
+            sums.torque[jl] = add(sums.torque[jl], r.torque_partner);
+            sums.heat_flow[jl] -= r.heat_flow;
         }
         batch.consume();
     }
@@ -407,26 +423,81 @@ impl Owner {
     }
 
     /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.
-    fn add_to(&self, (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]), first_slot: usize) {
+    fn add_to(&self, sums: &mut Sums, first_slot: usize) {
         if self.slot == usize::MAX {
             return;
         }
         let il = self.slot - first_slot;
-        f[il] = add(f[il], self.force);
-        t[il] = add(t[il], self.torque);
-        q[il] += self.heat_flow;
+        sums.force[il] = add(sums.force[il], self.force);
+        sums.torque[il] = add(sums.torque[il], self.torque);
+        sums.heat_flow[il] += self.heat_flow;
     }
 }
 
-/// A task's force, torque and heat-flow pieces, its histories and touching flags, and the
-/// same for its wall candidates.
-type Accumulators<'a> = (
-    (&'a mut [Vec3], &'a mut [Vec3]),
-    (&'a mut [f64], (ListPieces<'a>, ListPieces<'a>)),
-);
+/// What a pair task writes, from where its pieces start: its particles' sums, and the
+/// histories and touching flags of its pair entries and of its wall candidates.
+struct TaskPieces<'a> {
+    sums: Sums<'a>,
+    pairs: ListPieces<'a>,
+    walls: ListPieces<'a>,
+}
+
+/// Where a task's pieces start in each kind of array.
+#[derive(Debug, Clone, Copy, Default)]
+struct TaskStart {
+    /// In the per-particle sums.
+    slot: usize,
+    /// In the pair entries of the list.
+    pair_entry: usize,
+    /// In the wall candidates of the list.
+    wall_candidate: usize,
+}
+
+impl Pieces for TaskPieces<'_> {
+    type At = TaskStart;
+    fn split(self, from: TaskStart, at: TaskStart) -> (Self, Self) {
+        let (sums0, sums1) = self.sums.split(from.slot, at.slot);
+        let (pairs0, pairs1) = self.pairs.split(from.pair_entry, at.pair_entry);
+        let (walls0, walls1) = self.walls.split(from.wall_candidate, at.wall_candidate);
+        (
+            TaskPieces {
+                sums: sums0,
+                pairs: pairs0,
+                walls: walls0,
+            },
+            TaskPieces {
+                sums: sums1,
+                pairs: pairs1,
+                walls: walls1,
+            },
+        )
+    }
+}
+
+/// The force, torque and heat flow each particle of a task's slots receives from its
+/// contacts.
+struct Sums<'a> {
+    force: &'a mut [Vec3],
+    torque: &'a mut [Vec3],
+    heat_flow: &'a mut [f64],
+}
+
+slices_indexed_alike!(Sums {
+    force,
+    torque,
+    heat_flow
+});
 
 /// Histories and touching flags of a task's list entries.
-type ListPieces<'a> = (&'a mut [ContactHistory], &'a mut [bool]);
+struct ListPieces<'a> {
+    histories: &'a mut [ContactHistory],
+    touching: &'a mut [bool],
+}
+
+slices_indexed_alike!(ListPieces {
+    histories,
+    touching
+});
 
 /// Where the arrays a pair task reads lie, for prefetching the next task's part of them.
 struct TaskArrays {
@@ -493,8 +564,11 @@ impl WallContacts<'_> {
         spheres: &SphereArrays,
         slots: Range<usize>,
         first_slot: usize,
-        (f, t, q): (&mut [Vec3], &mut [Vec3], &mut [f64]),
-        (h, touch): ListPieces,
+        sums: &mut Sums,
+        ListPieces {
+            histories: h,
+            touching: touch,
+        }: ListPieces,
     ) -> u64 {
         let first_entry = self.offsets[first_slot] as usize;
         let mut touching = 0;
@@ -519,10 +593,10 @@ impl WallContacts<'_> {
                 let (kin, lever) = sphere_wall::kinematics(&si, &c);
                 let resp = hertz_mindlin::respond(self.law, &kin, &mut h[local], self.dt);
                 touch[local] = true;
-                f[il] = add(f[il], resp.force);
-                t[il] = add(t[il], resp.torque_on_i(lever));
+                sums.force[il] = add(sums.force[il], resp.force);
+                sums.torque[il] = add(sums.torque[il], resp.torque_on_i(lever));
                 if let Some(tw) = self.walls.temperature(w) {
-                    q[il] +=
+                    sums.heat_flow[il] +=
                         self.heat.wall_conductance(c.overlap, si.radius) * (tw - spheres.temp[i]);
                 }
                 touching += 1;

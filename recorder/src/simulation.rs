@@ -1,7 +1,7 @@
 //! A drum case brought to life: insertion, settling, spin-up, temperatures at `t0`, heating.
 //! Owns the sets and the pipeline, and reports heat totals and group means.
 
-use crate::case::{Case, EndCaps, TemperatureMode};
+use crate::case::{Case, EndCaps, TemperatureSpec};
 use crate::contact::PairLaw;
 use crate::counters::Counters;
 use crate::format::Snapshot;
@@ -72,10 +72,7 @@ impl Simulation {
     pub fn new(case: &Case) -> Result<Self, SimulationError> {
         let p = &case.particles;
         let m = &case.material;
-        let start_temp = match case.temperature.mode {
-            TemperatureMode::Uniform => case.temperature.value.unwrap_or(0.0),
-            TemperatureMode::Split => case.temperature.cold.unwrap_or(0.0),
-        };
+        let start_temp = case.temperature.before_t0();
         let particles = insertion::insert(
             p.count,
             p.radius,
@@ -194,21 +191,21 @@ impl Simulation {
 
     /// Assigns the initial temperatures at `t0` and switches on the heated wall, if any.
     pub fn assign_temperatures(&mut self) {
-        let t = &self.case.temperature;
         let n = self.particles.len();
-        match t.mode {
-            TemperatureMode::Uniform => {
-                self.particles
-                    .temp
-                    .iter_mut()
-                    .for_each(|x| *x = t.value.unwrap_or(0.0));
+        match self.case.temperature {
+            TemperatureSpec::Uniform { value, .. } => {
+                self.particles.temp.iter_mut().for_each(|x| *x = value);
                 self.groups = Groups {
                     hot: Vec::new(),
                     split_at: None,
                 };
             }
-            TemperatureMode::Split => {
-                let axis = t.split_axis.index();
+            TemperatureSpec::Split {
+                hot: th,
+                cold: tc,
+                split_axis,
+            } => {
+                let axis = split_axis.index();
                 // rank by coordinate, ties by id: the first ⌊N/2⌋ are hot, whatever the tilt of the bed
                 let mut rank: Vec<usize> = (0..n).collect();
                 let key = |i: usize| (self.particles.pos[i][axis], self.particles.id[i]);
@@ -225,7 +222,6 @@ impl Simulation {
                 let split_at = 0.5
                     * (self.particles.pos[rank[n_hot.saturating_sub(1)]][axis]
                         + self.particles.pos[rank[n_hot]][axis]);
-                let (th, tc) = (t.hot.unwrap_or(0.0), t.cold.unwrap_or(0.0));
                 for i in 0..n {
                     self.particles.temp[i] = if hot[self.particles.id[i] as usize] {
                         th

@@ -8,7 +8,8 @@ pub trait Sum: Send + Default + Add<Output = Self> {}
 
 impl<T: Send + Default + Add<Output = T>> Sum for T {}
 
-/// Mutable arrays that split together: a slice, or a pair of them (nest pairs for more).
+/// Mutable arrays that split together: a slice, a pair of them (nest pairs for more), or a
+/// struct of them (named fields; [`slices_indexed_alike!`] for slices indexed alike).
 pub trait Pieces: Sized + Send {
     /// A position in each array.
     type At: Copy + Send + Sync;
@@ -31,6 +32,21 @@ impl<A: Pieces, B: Pieces> Pieces for (A, B) {
         ((a0, b0), (a1, b1))
     }
 }
+
+/// Implements [`Pieces`] for a struct of mutable slices indexed alike (one position in all
+/// of them): `slices_indexed_alike!(Name { field, … })`, the struct taking one lifetime.
+macro_rules! slices_indexed_alike {
+    ($name:ident { $($field:ident),+ $(,)? }) => {
+        impl $crate::slices::Pieces for $name<'_> {
+            type At = usize;
+            fn split(self, from: usize, at: usize) -> (Self, Self) {
+                $(let $field = self.$field.split_at_mut(at - from);)+
+                ($name { $($field: $field.0),+ }, $name { $($field: $field.1),+ })
+            }
+        }
+    };
+}
+pub(crate) use slices_indexed_alike;
 
 /// Runs `work(task, pieces)` for every task of `tasks`, in parallel, and sums the results
 /// (from `R::default()`).

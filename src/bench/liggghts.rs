@@ -4,7 +4,7 @@
 
 use crate::cli::BenchPlan;
 use anyhow::{bail, Context, Result};
-use recorder::case::{Case, ContactArea, EndCaps, RollingModel, TemperatureMode};
+use recorder::case::{Case, ContactArea, EndCaps, RollingModel, TemperatureSpec};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -102,10 +102,14 @@ fn next_prime(mut n: u64) -> u64 {
 
 /// Writes `in.drum` and the drum mesh for `case`, heating for `heating_steps` after `t0`.
 pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> Result<()> {
-    let t = &case.temperature;
-    if t.mode != TemperatureMode::Split {
+    let TemperatureSpec::Split {
+        hot,
+        cold,
+        split_axis,
+    } = case.temperature
+    else {
         bail!("--vs-liggghts: the deck needs temperature.mode = \"split\" (the case has a uniform start)");
-    }
+    };
     if case.conduction.contact_area != ContactArea::Overlap {
         bail!("--vs-liggghts: LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area (the case sets conduction.contact_area = \"hertz\")");
     }
@@ -136,7 +140,7 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         let path = dir.join(file);
         recorder::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
     }
-    let axis = t.split_axis.index();
+    let axis = split_axis.index();
     let ext = if axis == 1 { l / 2.0 + 0.01 } else { r + 0.01 };
     let block = |upper: &str| {
         let mut b = ["INF"; 6];
@@ -153,7 +157,6 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
     );
     let e_real = case.conduction.youngs_modulus_real;
     let settle = case.steps_in(case.time.settle);
-    let (hot, cold) = (t.hot.unwrap_or(0.0), t.cold.unwrap_or(0.0));
     let values: Vec<(&str, String)> = vec![
         (
             "case",

@@ -105,7 +105,7 @@ pub fn evaluate(
         output: extra.to_path_buf(),
         scheme: Scheme::Explicit,
         table: TableChoice::InMemoryIfItFits,
-        max_memory: None,
+        memory_limit: extrapolation::memory_limit(None),
         reproducible: false,
     };
     if let Err(e) = crate::with_workers(threads, || {

@@ -15,7 +15,7 @@ pub use table::{scan, Bodies, CflRow, Exchange, Table, TableScan};
 pub enum ReplayError {
     #[error(
         "the explicit scheme is unstable on this table: row {row} (bodies {i} and {j}, m = {duration_steps} steps, sqrt(a) = {sqrt_area:.4e} m) has CFL number c = H m (1/C_k + 1/C_l) = {cfl:.4} ≥ 1; \
-         record with a smaller --dtc-max (c scales with m) or replay with --scheme exact (unconditionally stable)"
+         the explicit scheme needs c < 1 on every row (c scales with m; the exact scheme is unconditionally stable)"
     )]
     Cfl {
         row: u64,
@@ -30,7 +30,7 @@ pub enum ReplayError {
     #[error(
         "not enough memory: even with the table streamed from the file, {particles} particles need {} \
          (per-particle state {}, pairing {}, buffers {}), more than the limit of {} ({limit_source}); \
-         allow more with --max-memory (at least {}) or free memory",
+         the replay needs a limit of at least {}",
         memory::human_bytes(*needed),
         memory::human_bytes(*particle_bytes),
         if *pairing_bytes == 0 { "stored".to_string() } else { memory::human_bytes(*pairing_bytes) },

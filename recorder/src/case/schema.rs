@@ -1,5 +1,6 @@
 //! The TOML case file as the user writes it (serde schema; unknown keys refused).
 
+use super::validate::{refuse, Violation};
 use serde::{Deserialize, Serialize};
 
 /// A rotating-drum thermal DEM case, exactly as read from a `.toml` file.
@@ -158,31 +159,134 @@ pub struct TimeSpec {
     pub heating: Option<f64>,
 }
 
-/// Initial temperatures assigned at `t0`.
+/// Initial temperatures assigned at `t0`: the mode selects the fields it needs.
+///
+/// Read and written through [`TemperatureFields`], the `[temperature]` table as the file
+/// spells it, so a file names the mode with `mode = "…"` and a recording's resolved case
+/// keeps today's keys (every field, `null` where the mode has none).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "TemperatureFields", into = "TemperatureFields")]
+pub enum TemperatureSpec {
+    /// The bed in two halves across `split_axis`: the half with the smaller coordinate at
+    /// `hot`, the other at `cold` (K). The plane is placed so that exactly ⌊N/2⌋ particles
+    /// are hot.
+    Split {
+        hot: f64,
+        cold: f64,
+        split_axis: Axis,
+    },
+    /// Every particle at `value` (K). A `split_axis` in the file has no effect here; it is
+    /// kept so that the resolved case a recording stores says what the file said.
+    Uniform { value: f64, split_axis: Axis },
+}
+
+impl TemperatureSpec {
+    /// The temperature of every particle before `t0` (K): the uniform value, or the cold
+    /// half's (the insertion needs one; the split is made at `t0`).
+    pub fn before_t0(&self) -> f64 {
+        match *self {
+            TemperatureSpec::Split { cold, .. } => cold,
+            TemperatureSpec::Uniform { value, .. } => value,
+        }
+    }
+}
+
+/// The `[temperature]` table as written: every key of every mode, checked against the mode
+/// when it becomes a [`TemperatureSpec`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct TemperatureSpec {
-    pub mode: TemperatureMode,
-    /// `split`: temperature of the hot half (K).
+struct TemperatureFields {
+    mode: TemperatureMode,
     #[serde(default)]
-    pub hot: Option<f64>,
-    /// `split`: temperature of the cold half (K).
+    hot: Option<f64>,
     #[serde(default)]
-    pub cold: Option<f64>,
-    /// `split`: the axis across which the bed is split; the half with the smaller
-    /// coordinate is hot. The plane is placed so that exactly ⌊N/2⌋ particles are hot.
+    cold: Option<f64>,
     #[serde(default)]
-    pub split_axis: Axis,
-    /// `uniform`: the temperature of every particle (K).
+    split_axis: Axis,
     #[serde(default)]
-    pub value: Option<f64>,
+    value: Option<f64>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
-pub enum TemperatureMode {
+enum TemperatureMode {
     Split,
     Uniform,
+}
+
+impl TryFrom<TemperatureFields> for TemperatureSpec {
+    type Error = Violation;
+
+    /// Refuses a key the mode requires and is missing, or one that belongs to the other mode.
+    fn try_from(fields: TemperatureFields) -> Result<Self, Violation> {
+        let TemperatureFields {
+            mode,
+            hot,
+            cold,
+            split_axis,
+            value,
+        } = fields;
+        let required = |field: &str, mode: &str| {
+            refuse(
+                field,
+                "(missing)",
+                format!("required when mode = \"{mode}\""),
+            )
+        };
+        let only_in = |field: &str, v: f64, mode: &str| {
+            refuse(
+                field,
+                format!("{v} K"),
+                format!("only allowed when mode = \"{mode}\""),
+            )
+        };
+        match mode {
+            TemperatureMode::Split => {
+                let hot = hot.ok_or_else(|| required("temperature.hot", "split"))?;
+                let cold = cold.ok_or_else(|| required("temperature.cold", "split"))?;
+                if let Some(v) = value {
+                    return Err(only_in("temperature.value", v, "uniform"));
+                }
+                Ok(TemperatureSpec::Split {
+                    hot,
+                    cold,
+                    split_axis,
+                })
+            }
+            TemperatureMode::Uniform => {
+                let value = value.ok_or_else(|| required("temperature.value", "uniform"))?;
+                if let Some(h) = hot.or(cold) {
+                    return Err(only_in("temperature.hot/cold", h, "split"));
+                }
+                Ok(TemperatureSpec::Uniform { value, split_axis })
+            }
+        }
+    }
+}
+
+impl From<TemperatureSpec> for TemperatureFields {
+    fn from(spec: TemperatureSpec) -> Self {
+        match spec {
+            TemperatureSpec::Split {
+                hot,
+                cold,
+                split_axis,
+            } => TemperatureFields {
+                mode: TemperatureMode::Split,
+                hot: Some(hot),
+                cold: Some(cold),
+                split_axis,
+                value: None,
+            },
+            TemperatureSpec::Uniform { value, split_axis } => TemperatureFields {
+                mode: TemperatureMode::Uniform,
+                hot: None,
+                cold: None,
+                split_axis,
+                value: Some(value),
+            },
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]

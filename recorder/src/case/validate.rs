@@ -21,7 +21,23 @@ pub struct Violation {
     pub limit: String,
 }
 
-fn refuse(field: &str, value: impl std::fmt::Display, limit: impl Into<String>) -> Violation {
+/// The words of [`super::CaseError::Invalid`] after the file name; a refusal made while the
+/// file is read (by serde) says them inside the parse error.
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} = {} is not allowed: {}",
+            self.field, self.value, self.limit
+        )
+    }
+}
+
+pub(super) fn refuse(
+    field: &str,
+    value: impl std::fmt::Display,
+    limit: impl Into<String>,
+) -> Violation {
     Violation {
         field: field.to_string(),
         value: value.to_string(),
@@ -167,50 +183,13 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
         positive("time.heating", h)?;
     }
 
-    let temp = &case.temperature;
-    match temp.mode {
-        TemperatureMode::Split => {
-            let hot = temp.hot.ok_or_else(|| {
-                refuse(
-                    "temperature.hot",
-                    "(missing)",
-                    "required when mode = \"split\"",
-                )
-            })?;
-            let cold = temp.cold.ok_or_else(|| {
-                refuse(
-                    "temperature.cold",
-                    "(missing)",
-                    "required when mode = \"split\"",
-                )
-            })?;
+    // which keys each mode needs was settled when the file was read (`TemperatureSpec`)
+    match case.temperature {
+        TemperatureSpec::Split { hot, cold, .. } => {
             temperature("temperature.hot", hot)?;
             temperature("temperature.cold", cold)?;
-            if let Some(v) = temp.value {
-                return Err(refuse(
-                    "temperature.value",
-                    format!("{v} K"),
-                    "only allowed when mode = \"uniform\"",
-                ));
-            }
         }
-        TemperatureMode::Uniform => {
-            let v = temp.value.ok_or_else(|| {
-                refuse(
-                    "temperature.value",
-                    "(missing)",
-                    "required when mode = \"uniform\"",
-                )
-            })?;
-            temperature("temperature.value", v)?;
-            if let Some(h) = temp.hot.or(temp.cold) {
-                return Err(refuse(
-                    "temperature.hot/cold",
-                    format!("{h} K"),
-                    "only allowed when mode = \"split\"",
-                ));
-            }
-        }
+        TemperatureSpec::Uniform { value, .. } => temperature("temperature.value", value)?,
     }
 
     // The settled bed must fit, and insertion must have room for every particle.

@@ -246,18 +246,17 @@ fn snapshots_of(
             .iter()
             .map(|(s, files)| format!("{s} ({})", files_display(files)))
             .collect();
-        return Err(ImportError::Inconsistent(format!(
-            "{pattern}: no atom dump at t1 = timestep {} (t0 = timestep {step_t0}, the first \
-             atom dump, + τ = {period} steps); other atom timesteps found: {}. Dump the atoms \
-             at t0 and every τ steps after it (or give --tau / --tau-rev for the period that \
-             was dumped)",
-            step_t0.saturating_add(period),
-            if others.is_empty() {
+        return Err(ImportError::NoAtomDumpAtT1 {
+            pattern: pattern.to_string(),
+            step_t0,
+            step_t1: step_t0.saturating_add(period),
+            period,
+            others: if others.is_empty() {
                 "none".to_string()
             } else {
                 others.join(", ")
-            }
-        )));
+            },
+        });
     }
     Ok(AtomSnapshots {
         step_t0,

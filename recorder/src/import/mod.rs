@@ -25,6 +25,22 @@ pub enum ImportError {
     /// Dumps that are each well formed but do not make one recording together.
     #[error("{0}")]
     Inconsistent(String),
+    /// The atom dumps have `t0` but no frame `τ` steps later: they were dumped with
+    /// another period than the one asked for.
+    #[error(
+        "{pattern}: no atom dump at t1 = timestep {step_t1} (t0 = timestep {step_t0}, the \
+         first atom dump, + τ = {period} steps); other atom timesteps found: {others}. Dump \
+         the atoms at t0 and every τ steps after it, or import with τ set to the period that \
+         was dumped"
+    )]
+    NoAtomDumpAtT1 {
+        pattern: String,
+        step_t0: u64,
+        step_t1: u64,
+        period: u64,
+        /// The other atom timesteps seen, with their files (`none` without any).
+        others: String,
+    },
     /// The case cannot describe an imported run.
     #[error("{0}")]
     Case(String),
