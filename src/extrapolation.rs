@@ -78,7 +78,11 @@ pub fn memory_limit(max_memory: Option<u64>) -> MemoryLimit {
         },
         None => {
             let mut limit = MemoryLimit::available();
-            let verb = if limit.is_known() { "set it" } else { "set one" };
+            let verb = if limit.is_known() {
+                "set it"
+            } else {
+                "set one"
+            };
             limit.source = format!("{}; {verb} with --max-memory", limit.source);
             limit
         }

@@ -68,7 +68,7 @@ pub fn run(plan: RecordPlan) -> Result<()> {
                 );
             }
             crate::with_workers(plan.threads, || {
-                Ok(record::record_run(&run, &mut progress)?)
+                record::record_run(&run, &mut progress).map_err(advise)
             })
             .with_context(|| format!("recording case {}", case_path.display()))?;
             (output, case.name)
@@ -82,13 +82,8 @@ pub fn run(plan: RecordPlan) -> Result<()> {
             let output = checkpoint.dest.clone();
             eprintln!("resuming from {}", checkpoint.header);
             crate::with_workers(plan.threads, || {
-                Ok(record::resume(
-                    *checkpoint,
-                    &case,
-                    &path,
-                    checkpoint_every,
-                    &mut progress,
-                )?)
+                record::resume(*checkpoint, &case, &path, checkpoint_every, &mut progress)
+                    .map_err(advise)
             })
             .with_context(|| format!("resuming {}", path.display()))?;
             (output, case.name)
@@ -119,6 +114,16 @@ pub fn run(plan: RecordPlan) -> Result<()> {
         stage_seconds: costs.stage_seconds.clone(),
     };
     crate::inspect::emit(plan.json, &report, print_human)
+}
+
+/// The recorder states what went wrong; the advice about the flags is the CLI's.
+fn advise(error: record::RecordError) -> anyhow::Error {
+    match error {
+        record::RecordError::TwinIdentical { .. } => {
+            anyhow::Error::new(error).context("record without --twins")
+        }
+        error => error.into(),
+    }
 }
 
 fn print_human(report: &RecordReport) {

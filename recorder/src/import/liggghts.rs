@@ -8,7 +8,7 @@ use super::ImportError;
 use crate::case::{Case, ContactArea, EndCaps};
 use crate::format::{RecordingCosts, RecordingSummary, RecordingWriter, Snapshot};
 use crate::heat::ConductionLaw;
-use crate::record::recording::{recording_info, wall_infos, RunAtT0};
+use crate::record::metadata::{recording_info, wall_infos, RunAtT0};
 use crate::record::{ContactSampler, RecordOptions};
 use crate::wall::{WallMotion, WallSet};
 use std::path::{Path, PathBuf};
@@ -165,15 +165,8 @@ pub fn import(
     for snapshot in &atoms.snapshots[1..] {
         writer.write_snapshot(snapshot)?;
     }
-    let costs = RecordingCosts {
-        seconds_to_t0: 0.0,
-        seconds_period: 0.0,
-        seconds_reference: 0.0,
-        seconds_recorder: 0.0,
-        seconds_twins: 0.0,
-        stage_seconds: Default::default(),
-        threads: 0,
-    };
+    // no DEM ran here: every time and the thread count are 0
+    let costs = RecordingCosts::default();
     let summary = writer.finish(sampler.duration_histogram().to_vec(), Some(&costs))?;
     Ok(ImportReport {
         summary,

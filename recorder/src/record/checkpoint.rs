@@ -14,7 +14,8 @@
 //! bit for bit).
 
 use super::journal::JournalMark;
-use super::recording::{RecordOptions, RunAtT0};
+use super::metadata::{Elapsed, RunAtT0};
+use super::options::RecordOptions;
 use super::ContactSampler;
 use crate::case::Case;
 use crate::counters::Counters;
@@ -38,6 +39,13 @@ const HEADER_PREFIX: &str = "tdex checkpoint v";
 /// The header line is at most this long (a reader does not scan a large file for it).
 const MAX_HEADER: usize = 512;
 
+/// Where the checkpoints of a recording to `dest` go: `<dest>.checkpoint`.
+pub fn checkpoint_path(dest: &Path) -> PathBuf {
+    let mut name = dest.as_os_str().to_owned();
+    name.push(".checkpoint");
+    PathBuf::from(name)
+}
+
 /// Where a run stands.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Stage {
@@ -52,17 +60,6 @@ pub enum Stage {
     /// `done` steps into reference period `period` of DEM twin `twin` (1-based; the twins
     /// before it and its periods before `period` are stored).
     Twin { twin: u32, period: u32, done: u64 },
-}
-
-/// Wall-clock seconds spent so far, as the costs record reports them.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
-pub struct Elapsed {
-    pub to_t0: f64,
-    pub period: f64,
-    pub recorder: f64,
-    pub reference: f64,
-    /// The DEM twins' reference periods.
-    pub twins: f64,
 }
 
 /// The engine state a step depends on.

@@ -15,6 +15,13 @@ use std::path::{Path, PathBuf};
 /// `sqrt_area` (f64 bits), little-endian.
 pub const ROW_BYTES: usize = 28;
 
+/// The row journal kept beside a checkpoint: `<checkpoint>.rows`.
+pub fn journal_path(checkpoint: &Path) -> PathBuf {
+    let mut name = checkpoint.as_os_str().to_owned();
+    name.push(".rows");
+    PathBuf::from(name)
+}
+
 /// How far the journal had been synced when a checkpoint was taken.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct JournalMark {
@@ -98,12 +105,13 @@ impl RowJournal {
 
     /// Reopens the journal of a checkpoint: checks that its first `mark.rows` rows are the
     /// ones the checkpoint saw, hands them to `replay` in order (in blocks), drops whatever
-    /// was written after the checkpoint and positions the journal to append.
-    pub fn resume(
+    /// was written after the checkpoint and positions the journal to append. `replay`'s
+    /// errors (the caller's writer's) pass through as they are.
+    pub fn resume<E: From<JournalError>>(
         path: &Path,
         mark: JournalMark,
-        replay: &mut dyn FnMut(&[CollisionRow]) -> Result<(), super::RecordError>,
-    ) -> Result<Self, super::RecordError> {
+        replay: &mut dyn FnMut(&[CollisionRow]) -> Result<(), E>,
+    ) -> Result<Self, E> {
         let read_err = |error| JournalError::Read {
             path: path.to_path_buf(),
             error,
@@ -235,7 +243,7 @@ mod tests {
         drop(j);
 
         let mut replayed = Vec::new();
-        let mut j = RowJournal::resume(&path, mark, &mut |rows| {
+        let mut j = RowJournal::resume::<JournalError>(&path, mark, &mut |rows| {
             replayed.extend_from_slice(rows);
             Ok(())
         })
@@ -268,7 +276,7 @@ mod tests {
         bytes[500] ^= 1;
         std::fs::write(&path, &bytes).unwrap();
         let mut calls = 0;
-        let err = RowJournal::resume(&path, mark, &mut |_| {
+        let err = RowJournal::resume::<JournalError>(&path, mark, &mut |_| {
             calls += 1;
             Ok(())
         })
@@ -277,7 +285,7 @@ mod tests {
         assert!(err.to_string().contains("do not match"), "{err}");
         assert_eq!(calls, 0);
         std::fs::write(&path, &bytes[..ROW_BYTES * 10]).unwrap();
-        let err = RowJournal::resume(&path, mark, &mut |_| Ok(()))
+        let err = RowJournal::resume::<JournalError>(&path, mark, &mut |_| Ok(()))
             .err()
             .unwrap();
         assert!(err.to_string().contains("holds 10 rows"), "{err}");

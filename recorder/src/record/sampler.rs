@@ -88,7 +88,7 @@ pub struct ContactSampler {
 impl ContactSampler {
     /// `None` unless `every > 0` and `max_duration` is a positive multiple of `every`.
     pub fn new(every: u32, max_duration: u32) -> Option<Self> {
-        if every == 0 || max_duration == 0 || max_duration % every != 0 {
+        if every == 0 || max_duration == 0 || !max_duration.is_multiple_of(every) {
             return None;
         }
         Some(Self {
@@ -327,7 +327,7 @@ mod tests {
             state = state
                 .wrapping_mul(6364136223846793005)
                 .wrapping_add(1442695040888963407);
-            (state >> 33) % 4 != 0
+            !(state >> 33).is_multiple_of(4)
         };
         for (every, max) in [(1u32, 10u32), (2, 10), (5, 20), (10, 100)] {
             let samples = 300u64;

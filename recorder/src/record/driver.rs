@@ -1,0 +1,770 @@
+//! The recorder's driver: runs a case to `t0`, records the period `[t0, t1]`, the reference
+//! periods and the DEM twins into one recording (checkpointed when asked) or into several
+//! samplings of one run; the entry points of `tdex record` and of the studies.
+
+use super::checkpoint::{checkpoint_path, Checkpoint, EngineState, OutputState, Restored, Stage};
+use super::error::RecordError;
+use super::journal::{JournalMark, RowJournal};
+use super::metadata::{recording_info, stage_seconds, Elapsed, RunAtT0};
+use super::options::{Phase, RecordJob, RecordOptions, RecordRun, REPORT_EVERY};
+use super::period::{record_period, PeriodCheckpoint, RecorderState, RowSink};
+use super::saver::Saver;
+use super::ContactSampler;
+use crate::case::Case;
+use crate::format::{RecordingSummary, RecordingWriter, Snapshot};
+use crate::Simulation;
+use std::borrow::Cow;
+use std::path::Path;
+use std::time::Instant;
+
+/// Runs the case and writes the recording to `dest`. `case_toml` is the case file as given.
+pub fn record(
+    case: &Case,
+    case_path: &Path,
+    case_toml: &str,
+    opts: &RecordOptions,
+    dest: &Path,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let run = RecordRun {
+        case,
+        case_path,
+        case_toml,
+        options: opts,
+        dest,
+        checkpoint_every: None,
+        write_costs: true,
+    };
+    record_run(&run, progress)
+}
+
+/// Runs the case and writes the recording, checkpointing every `run.checkpoint_every`
+/// seconds of wall time to [`checkpoint_path`]`(dest)`; the checkpoint and its row journal
+/// are removed once the recording is in place.
+pub fn record_run(
+    run: &RecordRun,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let saver = match run.checkpoint_every {
+        Some(every) => Some(Saver::new(run, &checkpoint_path(run.dest), every)?),
+        None => None,
+    };
+    drive_one(run, Start::Case(run.case), saver, progress)
+}
+
+/// Resumes the run in which `checkpoint` (read from `path` by [`Checkpoint::read`], its
+/// case from [`Checkpoint::case`]) was taken, writing further checkpoints to `path` every
+/// `every` seconds (default: as before). The recording is the one the run would have
+/// written uninterrupted, to the byte, up to the costs record (which adds the wall times of
+/// both runs).
+pub fn resume(
+    checkpoint: Checkpoint<'static>,
+    case: &Case,
+    path: &Path,
+    every: Option<f64>,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let (case_toml, case_path) = (
+        checkpoint.case_toml.clone().into_owned(),
+        checkpoint.case_path.clone(),
+    );
+    let (options, dest) = (checkpoint.options.clone(), checkpoint.dest.clone());
+    let run = RecordRun {
+        case,
+        case_path: &case_path,
+        case_toml: &case_toml,
+        options: &options,
+        dest: &dest,
+        checkpoint_every: Some(every.unwrap_or(checkpoint.every_seconds)),
+        write_costs: checkpoint.write_costs,
+    };
+    let restored = checkpoint.restore(case, path)?;
+    // temporary files of the killed run (its output, a checkpoint it was writing)
+    crate::output::remove_stale_temps(&dest);
+    crate::output::remove_stale_temps(path);
+    let saver = Saver::new(&run, path, run.checkpoint_every.expect("set above"))?;
+    let start = Start::Restored(Box::new(restored));
+    drive_one(&run, start, Some(saver), progress)
+}
+
+/// Inserts, settles and spins the drum up to `t0`, then assigns the initial temperatures.
+pub fn run_to_t0(
+    case: &Case,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Simulation, RecordError> {
+    let mut sim = Simulation::new(case)?;
+    advance_to_t0(
+        &mut sim,
+        Stage::Settle { done: 0 },
+        progress,
+        &mut |_, _| Ok(()),
+    )?;
+    Ok(sim)
+}
+
+/// Records the period `[t0, t1]` of a simulation standing at `t0` (and the reference
+/// periods) into `dest`.
+pub fn record_from_t0(
+    sim: &mut Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    opts: &RecordOptions,
+    dest: &Path,
+    seconds_to_t0: f64,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let job = RecordJob {
+        options: opts.clone(),
+        dest,
+    };
+    let mut summaries =
+        record_many_from_t0(sim, case_path, case_toml, &[job], seconds_to_t0, progress)?;
+    Ok(summaries.pop().expect("one summary per job"))
+}
+
+/// Records several samplings of one DEM run: the simulation standing at `t0` is stepped
+/// once through the period and the reference periods, and every job's sampler is fed the
+/// contact list at its own steps (`k` a multiple of its `n`). Sampling only reads the state,
+/// so each file holds the table and snapshots that a run with its options alone would write;
+/// only the costs differ: `seconds_period` is the period's wall time (shared) and
+/// `seconds_recorder` the job's own sampler, splitter and writer time. Jobs must share
+/// `period_steps` and `reference_periods`; DEM twins are recorded by [`record_run`] alone.
+pub fn record_many_from_t0(
+    sim: &mut Simulation,
+    case_path: &Path,
+    case_toml: &str,
+    jobs: &[RecordJob],
+    seconds_to_t0: f64,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Vec<RecordingSummary>, RecordError> {
+    let shared = |j: &RecordJob| (j.options.period_steps, j.options.reference_periods);
+    if jobs.windows(2).any(|w| shared(&w[0]) != shared(&w[1])) {
+        return Err(RecordError::Settings(
+            "the recordings of one run must share τ and the reference periods".into(),
+        ));
+    }
+    if jobs.iter().any(|j| j.options.twins > 0) {
+        return Err(RecordError::Settings(
+            "DEM twins are recorded by a single recording run from the case's start, not by \
+             recordings from a state at t0"
+                .into(),
+        ));
+    }
+    let dem = DemRun {
+        case_path,
+        case_toml,
+        jobs,
+        write_costs: true,
+    };
+    let start = Start::AtT0 { sim, seconds_to_t0 };
+    drive(&dem, start, None, progress)
+}
+
+/// DEM twin `twin` (1-based) of the run standing at `t1`: the same state with the drum's
+/// angular velocity changed by `twin` units in the last place. Granular flow is chaotic, so
+/// this round-off change parts the twin from the DEM by particle diameters within a period
+/// while leaving every law and setting the same: the twin is one more DEM run of the case.
+pub fn twin_of(at_t1: &Simulation, twin: u32) -> Simulation {
+    let mut sim = at_t1.clone();
+    let omega = sim.walls.angular_velocity;
+    sim.walls.angular_velocity = f64::from_bits(omega.to_bits() + twin as u64);
+    sim
+}
+
+/// The recordings one DEM run feeds: one when the run is checkpointed or has DEM twins,
+/// several samplings of the same run otherwise. The case is the simulation's.
+struct DemRun<'a> {
+    case_path: &'a Path,
+    case_toml: &'a str,
+    jobs: &'a [RecordJob<'a>],
+    write_costs: bool,
+}
+
+/// Where the driver takes a run up.
+enum Start<'s> {
+    /// The first step of the case.
+    Case(&'s Case),
+    /// A simulation standing at `t0` (temperatures assigned), `seconds_to_t0` of wall time
+    /// after the case's first step.
+    AtT0 {
+        sim: &'s mut Simulation,
+        seconds_to_t0: f64,
+    },
+    /// A checkpoint's state.
+    Restored(Box<Restored>),
+}
+
+/// [`drive`] for the single recording of `run`.
+fn drive_one(
+    run: &RecordRun,
+    start: Start,
+    saver: Option<Saver>,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<RecordingSummary, RecordError> {
+    let job = RecordJob {
+        options: run.options.clone(),
+        dest: run.dest,
+    };
+    let dem = DemRun {
+        case_path: run.case_path,
+        case_toml: run.case_toml,
+        jobs: std::slice::from_ref(&job),
+        write_costs: run.write_costs,
+    };
+    let mut summaries = drive(&dem, start, saver, progress)?;
+    Ok(summaries.pop().expect("one summary per job"))
+}
+
+/// The sampler of a recording with `opts`, once the options are checked.
+fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
+    let every = opts.sample_every as u64;
+    if every == 0 || opts.period_steps == 0 || !opts.period_steps.is_multiple_of(every) {
+        return Err(RecordError::Settings(format!(
+            "τ = {} steps must be a positive multiple of n = {every}",
+            opts.period_steps
+        )));
+    }
+    if opts.twins > crate::format::MAX_TWINS || (opts.twins > 0 && opts.reference_periods == 0) {
+        return Err(RecordError::Settings(format!(
+            "{} DEM twins with {} reference periods: twins run over the reference periods, so \
+             they need at least one, and at most {} twins are recorded",
+            opts.twins,
+            opts.reference_periods,
+            crate::format::MAX_TWINS
+        )));
+    }
+    ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
+        RecordError::Settings(format!(
+            "Δt_c^max = {} steps must be a positive multiple of n = {}",
+            opts.dtc_max_steps, opts.sample_every
+        ))
+    })
+}
+
+/// Settles and spins up from where `stage` stands (if it is before `t0`) and assigns the
+/// initial temperatures; `checkpoint` is offered the state between blocks of steps.
+/// Returns the stage reached: the start of the period.
+fn advance_to_t0(
+    sim: &mut Simulation,
+    mut stage: Stage,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+    checkpoint: &mut dyn FnMut(&Simulation, Stage) -> Result<(), RecordError>,
+) -> Result<Stage, RecordError> {
+    let time = &sim.case.time;
+    let (n_settle, n_spin) = (
+        sim.case.steps_in(time.settle),
+        sim.case.steps_in(time.spin_up),
+    );
+    if let Stage::Settle { done } = stage {
+        run_phase(
+            sim,
+            done,
+            n_settle,
+            &mut |d| progress(Phase::Settle, d, n_settle),
+            &mut |sim, done| checkpoint(sim, Stage::Settle { done }),
+        )?;
+        sim.start_rotation();
+        stage = Stage::SpinUp { done: 0 };
+    }
+    if let Stage::SpinUp { done } = stage {
+        run_phase(
+            sim,
+            done,
+            n_spin,
+            &mut |d| progress(Phase::SpinUp, d, n_spin),
+            &mut |sim, done| checkpoint(sim, Stage::SpinUp { done }),
+        )?;
+        sim.assign_temperatures();
+        stage = Stage::Period { done: 0 };
+    }
+    Ok(stage)
+}
+
+/// Runs `total - done` more steps of a phase in blocks of [`REPORT_EVERY`] (counted from
+/// the phase's start), checking stability and reporting after each block and offering a
+/// checkpoint between blocks.
+fn run_phase(
+    sim: &mut Simulation,
+    mut done: u64,
+    total: u64,
+    progress: &mut dyn FnMut(u64),
+    checkpoint: &mut dyn FnMut(&Simulation, u64) -> Result<(), RecordError>,
+) -> Result<(), RecordError> {
+    while done < total {
+        let block = (REPORT_EVERY - done % REPORT_EVERY).min(total - done);
+        for _ in 0..block {
+            sim.step();
+        }
+        done += block;
+        sim.check_inside()?;
+        progress(done);
+        if done < total {
+            checkpoint(sim, done)?;
+        }
+    }
+    Ok(())
+}
+
+/// A twin that left the run bit for bit unchanged measures no spread: refused.
+fn check_twin_differs(
+    twin: u32,
+    snapshot: &Snapshot,
+    dem: Option<&Snapshot>,
+) -> Result<(), RecordError> {
+    let Some(dem) = dem else {
+        return Ok(());
+    };
+    if dem.pos == snapshot.pos && dem.temp == snapshot.temp {
+        return Err(RecordError::TwinIdentical {
+            twin,
+            snapshot: snapshot.index,
+        });
+    }
+    Ok(())
+}
+
+/// The whole run from wherever it stands: settle, spin-up, the recorded period, the
+/// reference periods, the DEM twins, with checkpoints when `saver` is given (a run with one
+/// recording). Returns each recording's summary, in the order of the jobs.
+fn drive(
+    dem: &DemRun,
+    start: Start,
+    mut saver: Option<Saver>,
+    progress: &mut dyn FnMut(Phase, u64, u64),
+) -> Result<Vec<RecordingSummary>, RecordError> {
+    let fresh_samplers = dem
+        .jobs
+        .iter()
+        .map(|j| check(&j.options))
+        .collect::<Result<Vec<_>, _>>()?;
+    // what the recordings share: τ, the reference periods and the twins
+    let Some(opts) = dem.jobs.first().map(|j| &j.options) else {
+        return Ok(Vec::new());
+    };
+    let mut own_sim;
+    let (sim, mut stage, mut elapsed, output, mut at_t1) = match start {
+        Start::Case(case) => {
+            own_sim = Simulation::new(case)?;
+            let stage = Stage::Settle { done: 0 };
+            (&mut own_sim, stage, Elapsed::default(), None, None)
+        }
+        Start::AtT0 { sim, seconds_to_t0 } => {
+            let elapsed = Elapsed {
+                to_t0: seconds_to_t0,
+                ..Elapsed::default()
+            };
+            (sim, Stage::Period { done: 0 }, elapsed, None, None)
+        }
+        Start::Restored(r) => {
+            let r = *r;
+            own_sim = r.sim;
+            (&mut own_sim, r.stage, r.elapsed, r.output, r.t1)
+        }
+    };
+
+    // to t0
+    if matches!(stage, Stage::Settle { .. } | Stage::SpinUp { .. }) {
+        let (began, base) = (Instant::now(), elapsed.to_t0);
+        let to_t0 = |elapsed: &Elapsed| Elapsed {
+            to_t0: base + began.elapsed().as_secs_f64(),
+            ..*elapsed
+        };
+        stage = advance_to_t0(sim, stage, progress, &mut |sim, stage| match &mut saver {
+            Some(s) if s.due() => s.save(sim, stage, to_t0(&elapsed), None),
+            _ => Ok(()),
+        })?;
+        elapsed = to_t0(&elapsed);
+    }
+
+    // the outputs: opened at t0, or rebuilt to where the checkpoint left them
+    let journal = saver.as_ref().map(|s| s.journal.clone());
+    let (mut sinks, mut samplers, mut snapshots, run_at_t0) = match output {
+        None => {
+            let run_at_t0 = RunAtT0::of(sim);
+            let t0 = sim.snapshot(0);
+            let mut sinks = Vec::with_capacity(dem.jobs.len());
+            for job in dem.jobs {
+                let info = recording_info(
+                    &sim.case,
+                    dem.case_path,
+                    dem.case_toml,
+                    &job.options,
+                    run_at_t0.clone(),
+                );
+                let mut writer = RecordingWriter::create(job.dest, info)?;
+                writer.write_snapshot(&t0)?;
+                let journal = match &journal {
+                    Some(path) => Some(RowJournal::create(path)?),
+                    None => None,
+                };
+                sinks.push(RowSink { writer, journal });
+            }
+            (sinks, fresh_samplers, vec![t0], run_at_t0)
+        }
+        Some(out) => {
+            let info = recording_info(
+                &sim.case,
+                dem.case_path,
+                dem.case_toml,
+                opts,
+                out.run.clone(),
+            );
+            let mut writer = RecordingWriter::create(dem.jobs[0].dest, info)?;
+            writer.write_snapshot(&out.snapshots[0])?;
+            let path = journal.as_ref().expect("a resumed run keeps checkpointing");
+            let journal = RowJournal::resume(path, out.journal, &mut |rows| {
+                writer
+                    .push_rows(rows.iter().copied())
+                    .map_err(RecordError::from)
+            })?;
+            // the run's own snapshots, then each twin's, in the order they were written
+            let own = 2 + opts.reference_periods as usize;
+            for (k, snapshot) in out.snapshots.iter().enumerate().skip(1) {
+                match k.checked_sub(own) {
+                    None => writer.write_snapshot(snapshot)?,
+                    Some(past) => writer.write_twin_snapshot(
+                        1 + (past / opts.reference_periods as usize) as u32,
+                        snapshot,
+                    )?,
+                }
+            }
+            let sink = RowSink {
+                writer,
+                journal: Some(journal),
+            };
+            (
+                vec![sink],
+                vec![out.sampler.into_owned()],
+                out.snapshots.into_owned(),
+                out.run,
+            )
+        }
+    };
+    // each recording's own recorder seconds; a checkpointed run has one recording, whose
+    // seconds `elapsed.recorder` carries
+    let mut recorder_seconds = vec![elapsed.recorder; sinks.len()];
+
+    // the recorded period
+    if let Stage::Period { done } = stage {
+        let began = Instant::now();
+        let mut hook = PeriodSaver {
+            saver: saver.as_mut(),
+            run_at_t0: &run_at_t0,
+            t0: &snapshots[0],
+            elapsed,
+            began,
+        };
+        let checkpoints: Option<&mut dyn PeriodCheckpoint> = match hook.saver {
+            Some(_) => Some(&mut hook),
+            None => None,
+        };
+        let every: Vec<u64> = dem
+            .jobs
+            .iter()
+            .map(|j| j.options.sample_every as u64)
+            .collect();
+        let busy;
+        (samplers, busy) = record_period(
+            sim,
+            samplers,
+            &mut sinks,
+            &every,
+            opts.period_steps,
+            done,
+            checkpoints,
+            progress,
+        )?;
+        let t1 = sim.snapshot(1);
+        for ((sink, seconds), busy) in sinks.iter_mut().zip(&mut recorder_seconds).zip(busy) {
+            let t = Instant::now();
+            sink.writer.write_snapshot(&t1)?;
+            *seconds += busy + t.elapsed().as_secs_f64();
+        }
+        if opts.twins > 0 {
+            at_t1 = Some(sim.clone());
+        }
+        // kept only for the checkpoints: a snapshot is 68 B a particle
+        if saver.is_some() {
+            snapshots.push(t1);
+        }
+        elapsed.recorder = recorder_seconds[0];
+        elapsed.period += began.elapsed().as_secs_f64();
+        stage = Stage::Reference { period: 0, done: 0 };
+    }
+
+    // the reference periods, then the DEM twins, each from t1 over the same periods (the
+    // run's own t2 is kept to check that the twins differ from it)
+    let mut dem_t2: Option<Snapshot> = None;
+    let mut main_stage_seconds = None;
+    if matches!(stage, Stage::Reference { .. } | Stage::Twin { .. }) {
+        let mark = match sinks.first_mut().and_then(|s| s.journal.as_mut()) {
+            Some(j) => Some(j.sync()?),
+            None => None,
+        };
+        let mut past_t1 = PastT1 {
+            opts,
+            saver: saver.as_mut(),
+            mark,
+            run_at_t0: &run_at_t0,
+            sampler: &samplers[0],
+            at_t1: at_t1.as_ref(),
+            elapsed,
+            began: Instant::now(),
+        };
+        if let Stage::Reference {
+            period: first,
+            done,
+        } = stage
+        {
+            past_t1.periods(
+                sim,
+                Continuation::Reference,
+                (first, done),
+                &mut snapshots,
+                progress,
+                &mut |period, snapshot| {
+                    for sink in sinks.iter_mut() {
+                        sink.writer.write_snapshot(snapshot)?;
+                    }
+                    if period == 0 && opts.twins > 0 {
+                        dem_t2 = Some(snapshot.clone());
+                    }
+                    Ok(())
+                },
+            )?;
+            past_t1.stage_done(Continuation::Reference);
+            if let Some(t1) = &at_t1 {
+                main_stage_seconds = Some(stage_seconds(sim));
+                *sim = twin_of(t1, 1);
+                stage = Stage::Twin {
+                    twin: 1,
+                    period: 0,
+                    done: 0,
+                };
+            }
+        }
+        if let Stage::Twin {
+            twin: first,
+            period: first_period,
+            done,
+        } = stage
+        {
+            let t1 = at_t1.as_ref().ok_or_else(|| {
+                RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
+            })?;
+            if dem_t2.is_none() {
+                dem_t2 = snapshots.get(2).cloned();
+            }
+            for twin in first..=opts.twins {
+                if twin != first {
+                    *sim = twin_of(t1, twin);
+                }
+                let from = if twin == first {
+                    (first_period, done)
+                } else {
+                    (0, 0)
+                };
+                past_t1.periods(
+                    sim,
+                    Continuation::Twin(twin),
+                    from,
+                    &mut snapshots,
+                    progress,
+                    &mut |period, snapshot| {
+                        if period == 0 {
+                            check_twin_differs(twin, snapshot, dem_t2.as_ref())?;
+                        }
+                        for sink in sinks.iter_mut() {
+                            sink.writer.write_twin_snapshot(twin, snapshot)?;
+                        }
+                        Ok(())
+                    },
+                )?;
+            }
+            past_t1.stage_done(Continuation::Twin(first));
+        }
+        elapsed = past_t1.elapsed;
+    }
+
+    // the run's own stages; a run resumed among its twins has only the last twin's, which
+    // carry the run's up to t1
+    let stage_seconds = main_stage_seconds.unwrap_or_else(|| stage_seconds(sim));
+    let summaries = sinks
+        .into_iter()
+        .zip(samplers)
+        .zip(recorder_seconds)
+        .map(|((sink, sampler), recorder)| {
+            let costs = dem.write_costs.then(|| {
+                Elapsed {
+                    recorder,
+                    ..elapsed
+                }
+                .costs(stage_seconds.clone())
+            });
+            let RowSink { writer, journal } = sink;
+            drop(journal);
+            Ok(writer.finish(sampler.duration_histogram().to_vec(), costs.as_ref())?)
+        })
+        .collect::<Result<Vec<_>, RecordError>>()?;
+    if let Some(s) = saver {
+        s.remove();
+    }
+    Ok(summaries)
+}
+
+/// A DEM run continued past `t1` over the reference periods: the run's own, or a twin's.
+#[derive(Debug, Clone, Copy)]
+enum Continuation {
+    Reference,
+    Twin(u32),
+}
+
+impl Continuation {
+    fn stage(self, period: u32, done: u64) -> Stage {
+        match self {
+            Continuation::Reference => Stage::Reference { period, done },
+            Continuation::Twin(twin) => Stage::Twin { twin, period, done },
+        }
+    }
+
+    fn phase(self) -> Phase {
+        match self {
+            Continuation::Reference => Phase::Reference,
+            Continuation::Twin(twin) => Phase::Twin(twin),
+        }
+    }
+}
+
+/// What the runs past `t1` need to checkpoint themselves: the output's state (fixed since
+/// `t1`), the state at `t1` while twins are to come, and the wall time of the stage.
+struct PastT1<'a, 's> {
+    /// What the recordings share: τ, the reference periods.
+    opts: &'a RecordOptions,
+    saver: Option<&'a mut Saver<'s>>,
+    mark: Option<JournalMark>,
+    run_at_t0: &'a RunAtT0,
+    sampler: &'a ContactSampler,
+    at_t1: Option<&'a Simulation>,
+    /// Elapsed times when the stage (re)started.
+    elapsed: Elapsed,
+    began: Instant,
+}
+
+impl PastT1<'_, '_> {
+    /// The elapsed times with the stage of `which` counted to now.
+    fn elapsed_now(&self, which: Continuation) -> Elapsed {
+        let now = self.began.elapsed().as_secs_f64();
+        match which {
+            Continuation::Reference => Elapsed {
+                reference: self.elapsed.reference + now,
+                ..self.elapsed
+            },
+            Continuation::Twin(_) => Elapsed {
+                twins: self.elapsed.twins + now,
+                ..self.elapsed
+            },
+        }
+    }
+
+    /// The stage of `which` is over: its wall time is counted, the next stage's starts now.
+    fn stage_done(&mut self, which: Continuation) {
+        self.elapsed = self.elapsed_now(which);
+        self.began = Instant::now();
+    }
+
+    /// Runs the reference periods of `which` from `(period, done)` on, offering checkpoints
+    /// between blocks of steps; each period's snapshot goes to `stored` (its index is
+    /// `period + 2`) and, when the run is checkpointed, into `snapshots`.
+    fn periods(
+        &mut self,
+        sim: &mut Simulation,
+        which: Continuation,
+        (first, done): (u32, u64),
+        snapshots: &mut Vec<Snapshot>,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+        stored: &mut dyn FnMut(u32, &Snapshot) -> Result<(), RecordError>,
+    ) -> Result<(), RecordError> {
+        let opts = self.opts;
+        let total = opts.reference_periods as u64 * opts.period_steps;
+        for period in first..opts.reference_periods {
+            let start = if period == first { done } else { 0 };
+            let offset = period as u64 * opts.period_steps;
+            run_phase(
+                sim,
+                start,
+                opts.period_steps,
+                &mut |d| progress(which.phase(), offset + d, total),
+                &mut |sim, done| {
+                    let elapsed = self.elapsed_now(which);
+                    let (Some(saver), Some(journal)) = (self.saver.as_deref_mut(), self.mark)
+                    else {
+                        return Ok(());
+                    };
+                    if !saver.due() {
+                        return Ok(());
+                    }
+                    let output = OutputState {
+                        run: self.run_at_t0.clone(),
+                        snapshots: Cow::Borrowed(snapshots),
+                        sampler: Cow::Borrowed(self.sampler),
+                        journal,
+                        t1_engine: self.at_t1.map(EngineState::of),
+                    };
+                    saver.save(sim, which.stage(period, done), elapsed, Some(output))
+                },
+            )?;
+            let snapshot = sim.snapshot(period + 2);
+            stored(period, &snapshot)?;
+            if self.saver.is_some() {
+                snapshots.push(snapshot);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The checkpoints of the recorded period: the engine from the DEM thread, the samplers and
+/// journal marks from the recorder thread, the rest from the driver.
+struct PeriodSaver<'a, 's> {
+    saver: Option<&'a mut Saver<'s>>,
+    run_at_t0: &'a RunAtT0,
+    t0: &'a Snapshot,
+    /// Elapsed times when the period (re)started.
+    elapsed: Elapsed,
+    began: Instant,
+}
+
+impl PeriodCheckpoint for PeriodSaver<'_, '_> {
+    fn due(&self) -> bool {
+        self.saver.as_ref().is_some_and(|s| s.due())
+    }
+
+    fn save(
+        &mut self,
+        sim: &Simulation,
+        done: u64,
+        recorder: RecorderState,
+    ) -> Result<(), RecordError> {
+        let Some(saver) = self.saver.as_deref_mut() else {
+            return Ok(());
+        };
+        let (Some(sampler), Some(Some(journal))) =
+            (recorder.samplers.first(), recorder.journals.first())
+        else {
+            return Ok(()); // only a single journaled recording is checkpointed
+        };
+        let output = OutputState {
+            run: self.run_at_t0.clone(),
+            snapshots: Cow::Borrowed(std::slice::from_ref(self.t0)),
+            sampler: Cow::Borrowed(sampler),
+            journal: *journal,
+            t1_engine: None,
+        };
+        let elapsed = Elapsed {
+            period: self.elapsed.period + self.began.elapsed().as_secs_f64(),
+            recorder: self.elapsed.recorder + recorder.busy[0],
+            ..self.elapsed
+        };
+        saver.save(sim, Stage::Period { done }, elapsed, Some(output))
+    }
+}
