@@ -63,6 +63,7 @@ fn main() -> ExitCode {
             let bad_input = |e: &(dyn std::error::Error + 'static)| {
                 e.is::<recorder::CaseError>()
                     || e.is::<cli::UsageError>()
+                    || e.is::<compare::CompareError>()
                     || e.is::<extrapolate::replay::ReplayError>()
                     || e.is::<extrapolate::pairing::PairingError>()
                     || e.downcast_ref::<recorder::format::FormatError>()

@@ -7,7 +7,6 @@ pub mod metrics;
 pub mod verdict;
 
 use crate::cli::ComparePlan;
-use crate::cli::UsageError;
 use anyhow::{Context, Result};
 use floor::Field;
 use metrics::Cells;
@@ -153,11 +152,74 @@ type SnapshotStream<'a> = Box<dyn Iterator<Item = Result<Snapshot>> + 'a>;
 /// The initially hot and cold particles of a run (`None`: a uniform start).
 type HotCold = Option<(Vec<u32>, Vec<u32>)>;
 
-/// The inputs cannot be compared (exit code 2, like any bad input).
-macro_rules! refuse {
-    ($($arg:tt)*) => {
-        return Err(UsageError(format!($($arg)*)).into())
-    };
+/// Runs or files that cannot be compared (bad input: exit code 2). Paths as displayed.
+#[derive(Debug, thiserror::Error)]
+pub enum CompareError {
+    #[error(
+        "{recording} is not a tdex recording but an extrapolation: the arguments are the wrong \
+         way round, the recording comes first (tdex compare RUN.mcap EXTRA.mcap)"
+    )]
+    Swapped { recording: String },
+    #[error(
+        "{extrapolation} was not extrapolated from {recording} (it names {named}, and the \
+         recordings' metadata differ)"
+    )]
+    NotExtrapolatedFrom {
+        extrapolation: String,
+        recording: String,
+        /// The recording the extrapolation names.
+        named: String,
+    },
+    #[error(
+        "{recording} has no DEM reference after t1: record it with `--reference K` (K ≥ the \
+         periods to compare) to compare an extrapolation"
+    )]
+    NoReference { recording: String },
+    #[error(
+        "{recording} has no DEM reference to measure further DEM runs such as {run} against: \
+         record it with --reference K to compare"
+    )]
+    NoReferenceForRuns { recording: String, run: String },
+    #[error(
+        "{recording}: only {drawn} of {cells} Voronoi seeds could be drawn inside the bed at t1"
+    )]
+    TooFewCells {
+        recording: String,
+        drawn: usize,
+        cells: usize,
+    },
+    #[error(
+        "{extrapolation} and {recording} share no extrapolated t_k: the recording's reference \
+         ends at t_{last}"
+    )]
+    NoCommonPeriod {
+        extrapolation: String,
+        recording: String,
+        last: u32,
+    },
+    #[error(
+        "{run} holds {run_particles} particles and {recording} {particles}: two DEM runs are \
+         compared only with the same particle count"
+    )]
+    ParticleCounts {
+        run: String,
+        recording: String,
+        run_particles: u32,
+        particles: u32,
+    },
+    #[error(
+        "{run}: its t_{k} is at {run_time} s and {recording}'s at {time} s; two DEM runs are \
+         compared at the same instants (t0 and the period τ must agree to half a step, \
+         {half_step} s)"
+    )]
+    Instants {
+        run: String,
+        recording: String,
+        k: u32,
+        run_time: f64,
+        time: f64,
+        half_step: f64,
+    },
 }
 
 pub fn run(plan: &ComparePlan) -> Result<()> {
@@ -167,11 +229,10 @@ pub fn run(plan: &ComparePlan) -> Result<()> {
         Err(FormatError::NotRecording { .. })
             if ExtrapolationReader::open(&plan.recording).is_ok() =>
         {
-            refuse!(
-                "{} is not a tdex recording but an extrapolation: the arguments are the \
-                 wrong way round, the recording comes first (tdex compare RUN.mcap EXTRA.mcap)",
-                plan.recording.display()
-            );
+            return Err(CompareError::Swapped {
+                recording: plan.recording.display().to_string(),
+            }
+            .into());
         }
         Err(e) => return Err(e.into()),
     };
@@ -259,11 +320,12 @@ pub fn compare_runs(
         Second::Extrapolation(extrapolation) => {
             let extra_path = extrapolation.path().display().to_string();
             if extrapolation.info().recording_info != *recording.info() {
-                refuse!(
-                    "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
-                     recordings' metadata differ)",
-                    extrapolation.info().recording
-                );
+                return Err(CompareError::NotExtrapolatedFrom {
+                    extrapolation: extra_path,
+                    recording: rec_path,
+                    named: extrapolation.info().recording.clone(),
+                }
+                .into());
             }
             // streamed: an extrapolation of hundreds of periods is never held whole
             let snaps: SnapshotStream = Box::new(
@@ -294,18 +356,20 @@ pub fn compare_runs(
     let t0 = dem_at(0).with_context(|| format!("{rec_path}: no snapshot at t0"))?;
     let t1 = dem_at(1).with_context(|| format!("{rec_path}: no snapshot at t1"))?;
     if dem.len() <= 2 {
-        refuse!(
-            "{rec_path} has no DEM reference after t1: record it with `--reference K` \
-             (K ≥ the periods to compare) to compare an extrapolation"
-        );
+        return Err(CompareError::NoReference {
+            recording: rec_path,
+        }
+        .into());
     }
     let reach = t1.radius.iter().copied().fold(0.0, f64::max);
     let cells_v = Cells::inside_bed(&t1.pos, reach, cells, seed);
     if cells_v.len() < cells {
-        refuse!(
-            "{rec_path}: only {} of {cells} Voronoi seeds could be drawn inside the bed at t1",
-            cells_v.len()
-        );
+        return Err(CompareError::TooFewCells {
+            recording: rec_path,
+            drawn: cells_v.len(),
+            cells,
+        }
+        .into());
     }
     let groups = metrics::hot_cold_groups(&t0.temp);
     // An extrapolation's ids are the recording's particles; a second run has its own, and
@@ -476,11 +540,12 @@ pub fn compare_runs(
         });
     }
     if periods.is_empty() {
-        refuse!(
-            "{extra_path} and {rec_path} share no extrapolated t_k: the recording's reference \
-             ends at t_{}",
-            dem.last().map_or(0, |s| s.index)
-        );
+        return Err(CompareError::NoCommonPeriod {
+            extrapolation: extra_path,
+            recording: rec_path,
+            last: dem.last().map_or(0, |s| s.index),
+        }
+        .into());
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
@@ -514,23 +579,27 @@ fn check_same_instants(
     let twin_path = twin.path().display().to_string();
     let (n, n_twin) = (recording.info().particles, twin.info().particles);
     if n != n_twin {
-        refuse!(
-            "{twin_path} holds {n_twin} particles and {rec_path} {n}: two DEM runs are compared \
-             only with the same particle count"
-        );
+        return Err(CompareError::ParticleCounts {
+            run: twin_path,
+            recording: rec_path,
+            run_particles: n_twin,
+            particles: n,
+        }
+        .into());
     }
     let half_step = 0.5 * recording.info().dt;
     for s in twin_snaps {
         if let Some(d) = dem.iter().find(|d| d.index == s.index) {
             if (d.time - s.time).abs() > half_step {
-                refuse!(
-                    "{twin_path}: its t_{k} is at {} s and {rec_path}'s at {} s; two DEM runs \
-                     are compared at the same instants (t0 and the period τ must agree to half \
-                     a step, {half_step} s)",
-                    s.time,
-                    d.time,
-                    k = s.index
-                );
+                return Err(CompareError::Instants {
+                    run: twin_path,
+                    recording: rec_path,
+                    k: s.index,
+                    run_time: s.time,
+                    time: d.time,
+                    half_step,
+                }
+                .into());
             }
         }
     }

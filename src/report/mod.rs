@@ -56,12 +56,10 @@ pub fn run(plan: &ReportPlan) -> Result<()> {
             plan.seed,
         )?)
     } else if let Some(run) = plan.dem_runs.first() {
-        return Err(crate::cli::UsageError(format!(
-            "{} has no DEM reference to measure further DEM runs such as {} against: record it \
-             with --reference K to compare",
-            recording.path().display(),
-            run.display()
-        ))
+        return Err(compare::CompareError::NoReferenceForRuns {
+            recording: recording.path().display().to_string(),
+            run: run.display().to_string(),
+        }
         .into());
     } else {
         None
@@ -115,11 +113,11 @@ pub fn write_with(
     let extra_path = extrapolation.path().display().to_string();
 
     if extrapolation.info().recording_info != *info {
-        return Err(crate::cli::UsageError(format!(
-            "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
-             recordings' metadata differ)",
-            extrapolation.info().recording
-        ))
+        return Err(compare::CompareError::NotExtrapolatedFrom {
+            extrapolation: extra_path,
+            recording: rec_path,
+            named: extrapolation.info().recording.clone(),
+        }
         .into());
     }
     let dem = recording

@@ -5,6 +5,7 @@ use super::table::{Bodies, Exchange};
 
 /// How the rows update the temperatures.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum Scheme {
     /// The paper's: rows one after the other, `Q = H (T_k − T_l)` held for `m`.
     Explicit,
