@@ -2,12 +2,12 @@
 //! revolution with a six-period DEM reference and one DEM twin (the DEM's own spread),
 //! extrapolate six periods, compare, report, and say how far to trust the prediction.
 
-use crate::cli::{DemoPlan, RecordPlan, RecordStart};
+use crate::cli::{DemoPlan, RecordPlan, RecordStart, SamplingFlags, Tau};
 use crate::{compare, extrapolation, record, report};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use extrapolate::{ExtrapolationRequest, TableChoice};
-use recorder::format::{ExtrapolationReader, RecordingReader};
+use recorder::format::{AreaEncoding, ExtrapolationReader, RecordingReader};
 
 /// The built-in case (the same text as `cases/small_drum.toml`).
 pub const CASE_TOML: &str = include_str!("../cases/small_drum.toml");
@@ -26,15 +26,24 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
     let recording = dir.join("run.mcap");
     let extra = dir.join("extra.mcap");
     let report_dir = dir.join("report");
+    let sampling = SamplingFlags::default();
 
     println!(
-        "1/4 record    {}: {} particles, one revolution (τ = {} s), n = 10, Δt_c^max = 100 steps,\n\
+        "1/4 record    {}: {} particles, one revolution (τ = {} s), n = {}, Δt_c^max = {} steps,\n\
          \x20             then {PERIODS} periods of DEM as the reference and {TWINS} DEM twin from t1",
         case_path.display(),
         case.particles.count,
-        case.drum.rotation_period
+        case.drum.rotation_period,
+        sampling.n,
+        sampling.dtc_max
     );
-    let mut options = crate::cli::record_options(&case, None, None, 10, 100, PERIODS, false)?;
+    let mut options = crate::cli::record_options(
+        &case,
+        Tau::ONE_REVOLUTION,
+        sampling,
+        PERIODS,
+        AreaEncoding::Quantized,
+    )?;
     options.twins = TWINS;
     record::run(RecordPlan {
         start: RecordStart::Fresh {

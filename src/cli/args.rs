@@ -1,7 +1,17 @@
-//! Raw command-line flags (clap derive).
+//! Command-line flags (clap derive): types, ranges, lists and defaults are clap's; what needs
+//! the case file or several flags together is checked in `plan`.
 
+use super::values::{count, non_negative, positive, Size};
 use clap::{Parser, Subcommand};
+use extrapolate::replay::Scheme;
 use std::path::PathBuf;
+
+/// Default sampling factor n (DEM steps between contact-list samples).
+pub const DEFAULT_N: u32 = 10;
+/// Default Δt_c^max (DEM steps).
+pub const DEFAULT_DTC_MAX: u32 = 100;
+/// Default period τ of the studies, as a fraction of a drum revolution.
+pub const DEFAULT_TAU_REV: f64 = 1.0;
 
 #[derive(Debug, Parser)]
 #[command(
@@ -21,7 +31,7 @@ pub enum Command {
         /// The case file (TOML).
         case: PathBuf,
         /// Worker threads (default: all cores). Results do not depend on it.
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
@@ -33,8 +43,12 @@ pub enum Command {
         /// The case file (TOML).
         #[arg(required_unless_present = "resume")]
         case: Option<PathBuf>,
+        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+        /// Required (`tdex record --resume` takes it from the checkpoint).
+        #[arg(short = 'o', long = "output", required_unless_present = "resume")]
+        output: Option<PathBuf>,
         #[command(flatten)]
-        table: TableFlags,
+        recording: RecordingFlags,
         /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
         #[arg(long, default_value_t = 0)]
         reference: u32,
@@ -45,7 +59,7 @@ pub enum Command {
         #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16), requires = "reference")]
         twins: u32,
         /// Worker threads (default: all cores). The recording does not depend on it.
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
@@ -53,7 +67,11 @@ pub enum Command {
         /// Every SECONDS of wall time, save the whole state of the run (atomically) to
         /// OUTPUT.checkpoint, with the table rows so far in OUTPUT.checkpoint.rows; both are
         /// removed when the recording is complete.
-        #[arg(long = "checkpoint-every", value_name = "SECONDS")]
+        #[arg(
+            long = "checkpoint-every",
+            value_name = "SECONDS",
+            value_parser = positive("give the seconds of wall time between checkpoints, > 0")
+        )]
         checkpoint_every: Option<f64>,
         /// Continue the run a checkpoint was taken in: `tdex record --resume
         /// OUTPUT.checkpoint`. The recording is the one the run would have written without
@@ -75,7 +93,7 @@ pub enum Command {
         /// The recording (MCAP).
         file: PathBuf,
         /// Worker threads (default: all cores). The pairing does not depend on it.
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
         /// Leave the time and thread count out of the stored pairing: the same recording
         /// then gives the same file byte for byte.
@@ -91,25 +109,24 @@ pub enum Command {
         /// The recording (MCAP).
         file: PathBuf,
         /// Periods to extrapolate after t1.
-        #[arg(long)]
+        #[arg(long, value_parser = periods())]
         periods: u32,
         /// The extrapolation to write (MCAP).
         #[arg(short = 'o', long = "output")]
         output: PathBuf,
-        /// explicit (the paper's), exact (pairwise exponential relaxation, always stable) or
-        /// synchronous (rows with the same start at once, as the DEM).
-        #[arg(long, default_value = "explicit")]
-        scheme: String,
+        /// How the rows update the temperatures.
+        #[arg(long, value_enum, default_value_t = Scheme::Explicit)]
+        scheme: Scheme,
         /// Read the table from the file every period instead of keeping it in memory.
         #[arg(long)]
         stream: bool,
         /// Memory the extrapolation may use, e.g. 512M, 4G (K, M, G, T: powers of 1024); a
         /// table that does not fit is streamed from the file. Default: 80 % of MemAvailable
         /// (and of what the cgroup still allows).
-        #[arg(long = "max-memory", value_name = "SIZE")]
-        max_memory: Option<String>,
+        #[arg(long = "max-memory", value_name = "SIZE", value_parser = Size)]
+        max_memory: Option<u64>,
         /// Worker threads (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
         /// Leave the costs record (wall times, thread count) out of the extrapolation: the
         /// same recording and flags then give the same file byte for byte.
@@ -130,7 +147,7 @@ pub enum Command {
         /// import), to see how far apart two DEM runs are on the same measures.
         extrapolation: PathBuf,
         /// Voronoi cells (seeds drawn inside the bed).
-        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
         cells: usize,
         /// Seed of the cell centres.
         #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
@@ -162,7 +179,7 @@ pub enum Command {
         #[arg(long = "dem-run", value_name = "RECORDING")]
         dem_runs: Vec<PathBuf>,
         /// Voronoi cells (seeds drawn inside the bed).
-        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
         cells: usize,
         /// Seed of the cell centres.
         #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
@@ -175,7 +192,7 @@ pub enum Command {
         #[arg(short = 'o', long = "output", default_value = "tdex-demo")]
         output: PathBuf,
         /// Worker threads (default: all cores). Results do not depend on it.
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
     },
     /// Benchmarks (figures for docs/benchmarks.md): `tdex bench CASE` times the DEM engine
@@ -215,10 +232,14 @@ pub struct BenchArgs {
     #[arg(required = true)]
     pub case: Option<PathBuf>,
     /// DEM steps to time after t0.
-    #[arg(long, default_value_t = 5000)]
+    #[arg(
+        long,
+        default_value_t = 5000,
+        value_parser = count::<u64>(1, "a whole number of steps", "give at least 1")
+    )]
     pub steps: u64,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(long, value_parser = threads())]
     pub threads: Option<usize>,
     /// Also run the same case in LIGGGHTS 3.8 (`liggghts` on PATH, one process) for the same
     /// steps and print both rates and their ratio.
@@ -239,20 +260,17 @@ pub enum BenchCommand {
     Record {
         /// The case file (TOML).
         case: PathBuf,
-        /// Period τ as a fraction of a drum revolution.
-        #[arg(long = "tau-rev", default_value_t = 1.0)]
-        tau_rev: f64,
-        /// Sampling factor n.
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in DEM steps.
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
+        #[command(flatten)]
+        recording: RecordingFlags,
         /// Plain/recorded pairs to run (the fastest of each is reported).
-        #[arg(long, default_value_t = 1)]
+        #[arg(
+            long,
+            default_value_t = 1,
+            value_parser = count::<u32>(1, "a whole number", "give at least 1")
+        )]
         repeats: u32,
         /// Worker threads (default: all cores).
-        #[arg(long)]
+        #[arg(long, value_parser = threads())]
         threads: Option<usize>,
         /// Print the result as one JSON object on stdout.
         #[arg(long)]
@@ -260,28 +278,47 @@ pub enum BenchCommand {
     },
 }
 
-/// The recording file and how its table is sampled: shared by `record` and `import`.
-#[derive(Debug, clap::Args)]
-pub struct TableFlags {
-    /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-    /// Required (`tdex record --resume` takes it from the checkpoint).
-    #[arg(short = 'o', long = "output")]
-    pub output: Option<PathBuf>,
+/// How a recording's table is sampled, over which period τ and at which precision: shared by
+/// `record`, `import liggghts` and `bench record`.
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct RecordingFlags {
     /// Period τ in seconds (default: one drum revolution).
-    #[arg(long, conflicts_with = "tau_rev")]
+    #[arg(long, conflicts_with = "tau_rev", value_parser = positive("give a period > 0 s"))]
     pub tau: Option<f64>,
     /// Period τ as a fraction of a drum revolution.
-    #[arg(long = "tau-rev")]
+    #[arg(long = "tau-rev", value_parser = tau_rev())]
     pub tau_rev: Option<f64>,
-    /// Sampling factor n: the contact list is sampled every n DEM steps.
-    #[arg(long = "n", default_value_t = 10)]
-    pub n: u32,
-    /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
-    #[arg(long = "dtc-max", default_value_t = 100)]
-    pub dtc_max: u32,
+    #[command(flatten)]
+    pub sampling: SamplingFlags,
     /// Store sqrt(a) as exact f64 instead of 16-bit codes (larger file; for exact replays).
     #[arg(long = "exact-area")]
     pub exact_area: bool,
+}
+
+/// How the contact list is sampled: every n DEM steps, collisions cut at Δt_c^max. Shared by
+/// every command that records (the sampling study takes lists of both instead).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct SamplingFlags {
+    /// Sampling factor n: the contact list is sampled every n DEM steps.
+    #[arg(
+        long = "n",
+        default_value_t = DEFAULT_N,
+        value_parser = count::<u32>(1, "a whole number of steps", "the sampling factor is at least 1 step")
+    )]
+    pub n: u32,
+    /// Δt_c^max in DEM steps (a multiple of n): longer collisions are split into rows.
+    #[arg(long = "dtc-max", default_value_t = DEFAULT_DTC_MAX)]
+    pub dtc_max: u32,
+}
+
+impl Default for SamplingFlags {
+    /// The flags' defaults, for the commands that record without them (`demo`).
+    fn default() -> Self {
+        SamplingFlags {
+            n: DEFAULT_N,
+            dtc_max: DEFAULT_DTC_MAX,
+        }
+    }
 }
 
 #[derive(Debug, Subcommand)]
@@ -301,8 +338,11 @@ pub enum ImportCommand {
         /// The case file describing the run (time step, materials, conduction, drum).
         #[arg(long)]
         case: PathBuf,
+        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+        #[arg(short = 'o', long = "output")]
+        output: PathBuf,
         #[command(flatten)]
-        table: TableFlags,
+        recording: RecordingFlags,
         /// Print the summary as one JSON object on stdout.
         #[arg(long)]
         json: bool,
@@ -327,7 +367,7 @@ pub enum ExportCommand {
 }
 
 /// Flags shared by the studies.
-#[derive(Debug, clap::Args)]
+#[derive(Debug, Clone, clap::Args)]
 pub struct StudyCommon {
     /// The case file (TOML).
     pub case: PathBuf,
@@ -336,10 +376,10 @@ pub struct StudyCommon {
     #[arg(short = 'o', long = "output")]
     pub output: Option<PathBuf>,
     /// Voronoi cells of the comparison.
-    #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS)]
+    #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
     pub cells: usize,
     /// Worker threads (default: all cores). Results do not depend on it.
-    #[arg(long)]
+    #[arg(long, value_parser = threads())]
     pub threads: Option<usize>,
     /// Print the study as one JSON object on stdout.
     #[arg(long)]
@@ -354,20 +394,33 @@ pub enum StudyCommand {
         #[command(flatten)]
         common: StudyCommon,
         /// Sampling factors n (steps), comma-separated.
-        #[arg(long = "n", default_value = "1,5,10,20", allow_hyphen_values = true)]
-        n: String,
+        #[arg(
+            long = "n",
+            value_delimiter = ',',
+            default_value = "1,5,10,20",
+            allow_hyphen_values = true,
+            value_parser = steps()
+        )]
+        n: Vec<u32>,
         /// Δt_c^max values (steps), comma-separated.
         #[arg(
             long = "dtc-max",
+            value_delimiter = ',',
             default_value = "10,50,100,200",
-            allow_hyphen_values = true
+            allow_hyphen_values = true,
+            value_parser = steps()
         )]
-        dtc_max: String,
+        dtc_max: Vec<u32>,
         /// Periods extrapolated and simulated by the DEM for reference.
-        #[arg(long, default_value_t = 6)]
+        #[arg(long, default_value_t = 6, value_parser = periods())]
         periods: u32,
         /// Period τ as a fraction of a drum revolution.
-        #[arg(long = "tau-rev", default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(
+            long = "tau-rev",
+            default_value_t = DEFAULT_TAU_REV,
+            allow_negative_numbers = true,
+            value_parser = tau_rev()
+        )]
         tau_rev: f64,
     },
     /// Pairing-period study (Figures 13–15, Table 8): per τ, record and extrapolate over the
@@ -378,19 +431,22 @@ pub enum StudyCommand {
         /// Periods τ as fractions of a revolution, comma-separated.
         #[arg(
             long = "tau-rev",
+            value_delimiter = ',',
             default_value = "0.25,0.5,1",
-            allow_hyphen_values = true
+            allow_hyphen_values = true,
+            value_parser = positive("give fractions of a revolution > 0")
         )]
-        tau_rev: String,
+        tau_rev: Vec<f64>,
         /// Revolutions covered after t1 by every τ (R / τ_rev periods each).
-        #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
+        #[arg(
+            long,
+            default_value_t = 3.0,
+            allow_negative_numbers = true,
+            value_parser = positive("give a number of revolutions > 0")
+        )]
         revolutions: f64,
-        /// Sampling factor n (steps).
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in steps (a multiple of n).
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
+        #[command(flatten)]
+        sampling: SamplingFlags,
     },
     /// Flow-regime study (Figures 11–12): per drum rotation period, the Froude number, the
     /// regime (Mellmann 2001), the dynamic angle of repose, the active-layer thickness and
@@ -401,28 +457,32 @@ pub enum StudyCommand {
         /// Drum rotation periods (s per revolution), comma-separated.
         #[arg(
             long = "rev-period",
+            value_delimiter = ',',
             default_value = "15,5,0.1",
-            allow_hyphen_values = true
+            allow_hyphen_values = true,
+            value_parser = positive("give rotation periods in seconds > 0")
         )]
-        rev_period: String,
+        rev_period: Vec<f64>,
         /// Periods extrapolated and simulated by the DEM for reference.
-        #[arg(long, default_value_t = 2)]
+        #[arg(long, default_value_t = 2, value_parser = periods())]
         periods: u32,
         /// Period τ as a fraction of a revolution.
-        #[arg(long = "tau-rev", default_value_t = 1.0, allow_negative_numbers = true)]
+        #[arg(
+            long = "tau-rev",
+            default_value_t = DEFAULT_TAU_REV,
+            allow_negative_numbers = true,
+            value_parser = tau_rev()
+        )]
         tau_rev: f64,
-        /// Sampling factor n (steps).
-        #[arg(long = "n", default_value_t = 10)]
-        n: u32,
-        /// Δt_c^max in steps (a multiple of n).
-        #[arg(long = "dtc-max", default_value_t = 100)]
-        dtc_max: u32,
+        #[command(flatten)]
+        sampling: SamplingFlags,
         /// No relative motion below this mean speed relative to solid-body rotation, as a
         /// fraction of the wall speed ωR: extrapolation is then refused.
         #[arg(
             long = "min-relative",
             default_value_t = crate::study::flow::MIN_RELATIVE,
-            allow_negative_numbers = true
+            allow_negative_numbers = true,
+            value_parser = non_negative("give a fraction of the wall speed ≥ 0")
         )]
         min_relative: f64,
     },
@@ -432,4 +492,33 @@ impl Cli {
     pub fn parse_args() -> Self {
         Self::parse()
     }
+}
+
+/// `--threads`: at least one worker.
+fn threads() -> super::values::Count<usize> {
+    count(1, "a whole number", "give at least 1")
+}
+
+/// `--periods` to extrapolate: at least one.
+fn periods() -> super::values::Count<u32> {
+    count(1, "a whole number", "extrapolate at least 1 period")
+}
+
+/// `--cells`: at least one Voronoi cell.
+fn cells() -> super::values::Count<usize> {
+    count(1, "a whole number", "give at least 1 Voronoi cell")
+}
+
+/// The items of the sampling study's `--n` and `--dtc-max` lists.
+fn steps() -> super::values::Count<u32> {
+    count(
+        1,
+        "a whole number of steps",
+        "give whole numbers of steps ≥ 1",
+    )
+}
+
+/// `--tau-rev`: τ as a fraction of a revolution.
+fn tau_rev() -> super::values::Real {
+    positive("give a fraction of a revolution > 0")
 }

@@ -2,11 +2,13 @@
 
 mod args;
 mod plan;
+mod values;
 
 pub use args::Cli;
+pub use args::SamplingFlags;
 pub(crate) use plan::record_options;
 pub use plan::{
     BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExportVtkPlan, ExtrapolatePlan, ImportPlan,
     InspectPlan, PairPlan, Plan, RecordPlan, RecordStart, RegimeRun, ReportPlan, RunPlan,
-    StudyKind, StudyPlan, UsageError,
+    StudyKind, StudyPlan, Tau, UsageError,
 };

@@ -1,8 +1,9 @@
-//! Validated plans: every flag and the case file are checked here, before any simulation starts.
+//! Validated plans: what clap cannot check — the flags against the case file and against
+//! each other, the files to read and write — is checked here, before any simulation starts.
 
 use super::args::{
-    BenchArgs, BenchCommand, Cli, Command, ExportCommand, ImportCommand, StudyCommand, StudyCommon,
-    TableFlags,
+    BenchArgs, BenchCommand, Cli, Command, ExportCommand, ImportCommand, RecordingFlags,
+    SamplingFlags, StudyCommand,
 };
 use anyhow::Result;
 use extrapolate::replay::Scheme;
@@ -11,8 +12,9 @@ use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
 
-/// A flag value outside its allowed range, or input files the command cannot use together
-/// (exit code 2).
+/// Flags that do not fit the case or each other, or outputs that cannot be written
+/// (exit code 2). A CLI type: the libraries and analysis modules report bad input with their
+/// own error types.
 #[derive(Debug)]
 pub struct UsageError(pub String);
 
@@ -207,11 +209,29 @@ pub struct RunPlan {
     pub json: bool,
 }
 
-fn threads(requested: Option<usize>) -> Result<usize> {
-    match requested {
-        Some(0) => Err(UsageError("--threads = 0 is not allowed: give at least 1".into()).into()),
-        Some(n) => Ok(n),
-        None => Ok(std::thread::available_parallelism().map_or(1, |n| n.get())),
+/// `--threads` (at least 1, checked by clap), or all cores.
+fn workers(requested: Option<usize>) -> usize {
+    requested.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// The period τ as given on the command line.
+#[derive(Debug, Clone, Copy)]
+pub enum Tau {
+    /// `--tau`: seconds.
+    Seconds(f64),
+    /// `--tau-rev`: a fraction of the case's drum revolution.
+    Revolutions(f64),
+}
+
+impl Tau {
+    /// τ when no flag sets it: one revolution.
+    pub const ONE_REVOLUTION: Tau = Tau::Revolutions(1.0);
+
+    fn seconds(self, revolution: f64) -> f64 {
+        match self {
+            Tau::Seconds(t) => t,
+            Tau::Revolutions(f) => f * revolution,
+        }
     }
 }
 
@@ -220,37 +240,31 @@ impl Plan {
         match cli.command {
             Command::Run {
                 case,
-                threads: t,
+                threads,
                 json,
             } => {
-                let threads = threads(t)?;
                 let loaded = recorder::case::load(&case)?;
                 Ok(Plan::Run(RunPlan {
                     case_path: case,
                     case: loaded,
-                    threads,
+                    threads: workers(threads),
                     json,
                 }))
             }
             Command::Record {
                 case,
-                table,
+                output,
+                recording,
                 reference,
                 twins,
-                threads: t,
+                threads,
                 json,
                 checkpoint_every,
                 resume,
                 reproducible,
             } => {
-                let threads = threads(t)?;
-                if let Some(s) = checkpoint_every.filter(|s| !(s.is_finite() && *s > 0.0)) {
-                    return Err(usage(format!(
-                        "--checkpoint-every = {s} is not allowed: give the seconds of wall time between checkpoints, > 0"
-                    )));
-                }
-                let start = match (resume, case) {
-                    (Some(path), _) => {
+                let start = match (resume, case, output) {
+                    (Some(path), _, _) => {
                         let checkpoint = recorder::record::Checkpoint::read(&path)?;
                         let case = checkpoint.case(&path)?;
                         RecordStart::Resume {
@@ -260,9 +274,10 @@ impl Plan {
                             checkpoint_every,
                         }
                     }
-                    (None, Some(case)) => {
+                    (None, Some(case), Some(output)) => {
                         let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                        let (mut options, output) = table_options(&loaded, &table, reference)?;
+                        let mut options = table_options(&loaded, &recording, reference)?;
+                        check_output(&output)?;
                         if twins > 0 && reference == 0 {
                             return Err(usage(format!(
                                 "--twins {twins} needs --reference K: the twins run over the \
@@ -280,27 +295,29 @@ impl Plan {
                             reproducible,
                         }
                     }
-                    (None, None) => {
+                    // clap requires both without --resume
+                    (None, _, _) => {
                         return Err(usage(
-                            "give the case file to record, or --resume CHECKPOINT".into(),
+                            "give the case file and -o OUTPUT to record, or --resume CHECKPOINT"
+                                .into(),
                         ))
                     }
                 };
                 Ok(Plan::Record(RecordPlan {
                     start,
-                    threads,
+                    threads: workers(threads),
                     json,
                 }))
             }
             Command::Inspect { file, json } => Ok(Plan::Inspect(InspectPlan { file, json })),
             Command::Pair {
                 file,
-                threads: t,
+                threads,
                 reproducible,
                 json,
             } => Ok(Plan::Pair(PairPlan {
                 file,
-                threads: threads(t)?,
+                threads: workers(threads),
                 reproducible,
                 json,
             })),
@@ -311,22 +328,10 @@ impl Plan {
                 scheme,
                 stream,
                 max_memory,
-                threads: t,
+                threads,
                 reproducible,
                 json,
             } => {
-                let threads = threads(t)?;
-                let max_memory = max_memory
-                    .map(|m| parse_size(&m).map_err(|e| usage(format!("--max-memory {m}: {e}"))))
-                    .transpose()?;
-                if periods == 0 {
-                    return Err(usage(
-                        "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
-                    ));
-                }
-                let scheme: Scheme = scheme
-                    .parse()
-                    .map_err(|e: String| usage(format!("--scheme: {e}")))?;
                 check_output(&output)?;
                 Ok(Plan::Extrapolate(ExtrapolatePlan {
                     file,
@@ -335,7 +340,7 @@ impl Plan {
                     scheme,
                     stream,
                     max_memory,
-                    threads,
+                    threads: workers(threads),
                     reproducible,
                     json,
                 }))
@@ -348,18 +353,15 @@ impl Plan {
                 json,
                 csv,
                 dem_runs,
-            } => {
-                check_cells(cells)?;
-                Ok(Plan::Compare(ComparePlan {
-                    recording,
-                    extrapolation,
-                    dem_runs,
-                    cells,
-                    seed,
-                    json,
-                    csv,
-                }))
-            }
+            } => Ok(Plan::Compare(ComparePlan {
+                recording,
+                extrapolation,
+                dem_runs,
+                cells,
+                seed,
+                json,
+                csv,
+            })),
             Command::Report {
                 recording,
                 extrapolation,
@@ -368,7 +370,6 @@ impl Plan {
                 cells,
                 seed,
             } => {
-                check_cells(cells)?;
                 check_output_dir(&output)?;
                 Ok(Plan::Report(ReportPlan {
                     recording,
@@ -379,21 +380,25 @@ impl Plan {
                     seed,
                 }))
             }
-            Command::Demo { output, threads: t } => {
-                let threads = threads(t)?;
+            Command::Demo { output, threads } => {
                 check_output_dir(&output)?;
-                Ok(Plan::Demo(DemoPlan { output, threads }))
+                Ok(Plan::Demo(DemoPlan {
+                    output,
+                    threads: workers(threads),
+                }))
             }
             Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
             Command::Import(ImportCommand::Liggghts {
                 atoms,
                 contacts,
                 case,
-                table,
+                output,
+                recording,
                 json,
             }) => {
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let (options, output) = table_options(&loaded, &table, 0)?;
+                let options = table_options(&loaded, &recording, 0)?;
+                check_output(&output)?;
                 Ok(Plan::ImportLiggghts(ImportPlan {
                     dumps: recorder::import::liggghts::Dumps { atoms, contacts },
                     case_path: case,
@@ -420,15 +425,11 @@ impl Plan {
                 command: None,
                 case: Some(case),
                 steps,
-                threads: t,
+                threads,
                 vs_liggghts,
                 liggghts_dir,
                 json,
             }) => {
-                let threads = threads(t)?;
-                if steps == 0 {
-                    return Err(usage("--steps = 0 is not allowed: give at least 1".into()));
-                }
                 let loaded = recorder::case::load(&case)?;
                 if let Some(dir) = &liggghts_dir {
                     check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
@@ -437,7 +438,7 @@ impl Plan {
                     case_path: case,
                     case: loaded,
                     steps,
-                    threads,
+                    threads: workers(threads),
                     liggghts: vs_liggghts.then_some(liggghts_dir),
                     json,
                 }))
@@ -449,30 +450,22 @@ impl Plan {
                 command:
                     Some(BenchCommand::Record {
                         case,
-                        tau_rev,
-                        n,
-                        dtc_max,
+                        recording,
                         repeats,
-                        threads: t,
+                        threads,
                         json,
                     }),
                 ..
             }) => {
-                let threads = threads(t)?;
-                if repeats == 0 {
-                    return Err(usage(
-                        "--repeats = 0 is not allowed: give at least 1".into(),
-                    ));
-                }
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = record_options(&loaded, None, Some(tau_rev), n, dtc_max, 0, false)?;
+                let options = table_options(&loaded, &recording, 0)?;
                 Ok(Plan::BenchRecord(BenchRecordPlan {
                     case_path: case,
                     case_toml,
                     case: loaded,
                     options,
                     repeats,
-                    threads,
+                    threads: workers(threads),
                     json,
                 }))
             }
@@ -484,59 +477,40 @@ fn usage(message: String) -> anyhow::Error {
     UsageError(message).into()
 }
 
-/// The recording settings of `record` and `import` checked against the case, and their
-/// output file (required).
-fn table_options(case: &Case, t: &TableFlags, reference: u32) -> Result<(RecordOptions, PathBuf)> {
-    let options = record_options(
-        case,
-        t.tau,
-        t.tau_rev,
-        t.n,
-        t.dtc_max,
-        reference,
-        t.exact_area,
-    )?;
-    let Some(output) = t.output.clone() else {
-        return Err(usage(
-            "-o/--output is required: give the recording to write, such as run.mcap".into(),
-        ));
+/// The recording flags of `record`, `import` and `bench record` checked against the case.
+fn table_options(case: &Case, flags: &RecordingFlags, reference: u32) -> Result<RecordOptions> {
+    // clap lets at most one of --tau and --tau-rev through
+    let tau = match (flags.tau, flags.tau_rev) {
+        (Some(t), _) => Tau::Seconds(t),
+        (None, Some(f)) => Tau::Revolutions(f),
+        (None, None) => Tau::ONE_REVOLUTION,
     };
-    check_output(&output)?;
-    Ok((options, output))
+    let area = if flags.exact_area {
+        AreaEncoding::Exact
+    } else {
+        AreaEncoding::Quantized
+    };
+    record_options(case, tau, flags.sampling, reference, area)
 }
 
-/// Checks the recording settings against the case: `τ` and `Δt_c^max` multiples of `n`.
+/// Checks the recording settings against the case: `τ` a whole number of steps and, with
+/// `Δt_c^max`, a multiple of `n`.
 pub(crate) fn record_options(
     case: &Case,
-    tau: Option<f64>,
-    tau_rev: Option<f64>,
-    n: u32,
-    dtc_max: u32,
+    tau: Tau,
+    sampling: SamplingFlags,
     reference: u32,
-    exact_area: bool,
+    area_encoding: AreaEncoding,
 ) -> Result<RecordOptions> {
-    let revolution = case.drum.rotation_period;
-    let tau_seconds = match (tau, tau_rev) {
-        (Some(t), _) if !(t.is_finite() && t > 0.0) => {
-            return Err(usage(format!(
-                "--tau = {t} is not allowed: give a period > 0 s"
-            )))
-        }
-        (_, Some(f)) if !(f.is_finite() && f > 0.0) => {
-            return Err(usage(format!(
-                "--tau-rev = {f} is not allowed: give a fraction of a revolution > 0"
-            )))
-        }
-        (Some(t), _) => t,
-        (_, Some(f)) => f * revolution,
-        (None, None) => revolution,
-    };
+    let SamplingFlags { n, dtc_max } = sampling;
+    let tau_seconds = tau.seconds(case.drum.rotation_period);
+    // clap refuses n = 0 on the command line; this guards the other callers
     if n == 0 {
         return Err(usage(
             "--n = 0 is not allowed: the sampling factor is at least 1 step".into(),
         ));
     }
-    if dtc_max == 0 || dtc_max % n != 0 {
+    if dtc_max == 0 || !dtc_max.is_multiple_of(n) {
         return Err(usage(format!(
             "--dtc-max = {dtc_max} is not allowed: Δt_c^max must be a positive multiple of n = {n} steps (e.g. {})",
             n * (dtc_max / n).max(1)
@@ -546,7 +520,7 @@ pub(crate) fn record_options(
     let period_steps = exact_steps.round() as u64;
     if period_steps == 0
         || (exact_steps - period_steps as f64).abs() > 1e-6 * exact_steps
-        || period_steps % n as u64 != 0
+        || !period_steps.is_multiple_of(u64::from(n))
     {
         let valid = (exact_steps / n as f64).round().max(1.0) * n as f64 * case.time.dt;
         return Err(usage(format!(
@@ -563,11 +537,7 @@ pub(crate) fn record_options(
         period_steps,
         reference_periods: reference,
         twins: 0,
-        area_encoding: if exact_area {
-            AreaEncoding::Exact
-        } else {
-            AreaEncoding::Quantized
-        },
+        area_encoding,
     })
 }
 
@@ -598,44 +568,6 @@ fn check_parent(output: &std::path::Path) -> Result<()> {
     Ok(())
 }
 
-/// A size such as `512M`, `4G`, `1.5G`, `100K` or `1048576` (bytes): K, M, G, T are powers
-/// of 1024, an optional `B` or `iB` may follow; at least 1 MiB.
-pub(crate) fn parse_size(text: &str) -> std::result::Result<u64, String> {
-    let t = text.trim();
-    let lower = t.to_ascii_lowercase();
-    let lower = lower
-        .strip_suffix("ib")
-        .or_else(|| lower.strip_suffix('b'))
-        .unwrap_or(&lower);
-    let (number, shift) = match lower.chars().last() {
-        Some('k') => (&lower[..lower.len() - 1], 10),
-        Some('m') => (&lower[..lower.len() - 1], 20),
-        Some('g') => (&lower[..lower.len() - 1], 30),
-        Some('t') => (&lower[..lower.len() - 1], 40),
-        _ => (lower, 0),
-    };
-    let allowed =
-        "give a size such as 512M, 4G or 1.5G (K, M, G, T: powers of 1024; a bare number is bytes)";
-    let value: f64 = number
-        .trim()
-        .parse()
-        .map_err(|_| format!("not a size; {allowed}"))?;
-    let bytes = value * (1u64 << shift) as f64;
-    if !(bytes.is_finite() && bytes >= (1u64 << 20) as f64 && bytes < u64::MAX as f64) {
-        return Err(format!("too small or too large: at least 1M; {allowed}"));
-    }
-    Ok(bytes as u64)
-}
-
-fn check_cells(cells: usize) -> Result<()> {
-    if cells == 0 {
-        return Err(usage(
-            "--cells = 0 is not allowed: give at least 1 Voronoi cell".into(),
-        ));
-    }
-    Ok(())
-}
-
 /// An output directory: an existing directory, or a new one whose parent exists.
 fn check_output_dir(dir: &std::path::Path) -> Result<()> {
     check_dir("-o", dir, "the output")
@@ -652,101 +584,46 @@ fn check_dir(flag: &str, dir: &std::path::Path, what: &str) -> Result<()> {
     check_parent(dir)
 }
 
-/// A comma-separated list of values for `flag`: no empty list, no empty or unparsable item;
-/// repeated values are kept once, in the order given.
-fn parse_list<T: std::str::FromStr + PartialEq + Copy>(
-    flag: &str,
-    text: &str,
-    kind: &str,
-) -> Result<Vec<T>> {
-    let mut values = Vec::new();
-    if text.trim().is_empty() {
-        return Err(usage(format!(
-            "{flag} is empty: give at least one {kind}, comma-separated"
-        )));
-    }
-    for item in text.split(',').map(str::trim) {
-        let v: T = item.parse().map_err(|_| {
-            usage(format!(
-                "{flag} = {text:?}: {item:?} is not {kind} (give a comma-separated list)"
-            ))
-        })?;
-        if !values.contains(&v) {
-            values.push(v);
+/// The list's values, each kept once in the order given.
+fn distinct<T: PartialEq>(values: Vec<T>) -> Vec<T> {
+    let mut kept = Vec::with_capacity(values.len());
+    for v in values {
+        if !kept.contains(&v) {
+            kept.push(v);
         }
     }
-    Ok(values)
+    kept
 }
 
-/// Whole-number lists (`--n`, `--dtc-max`): every value ≥ 1.
-fn positive_steps(flag: &str, text: &str) -> Result<Vec<u32>> {
-    let values: Vec<i64> = parse_list(flag, text, "a whole number of steps")?;
-    values
-        .into_iter()
-        .map(|v| {
-            u32::try_from(v).ok().filter(|v| *v > 0).ok_or_else(|| {
-                usage(format!(
-                    "{flag} = {v} is not allowed: give whole numbers of steps ≥ 1"
-                ))
-            })
-        })
-        .collect()
-}
-
-/// Real-valued lists (`--tau-rev`, `--rev-period`): every value finite and > 0.
-fn positive_reals(flag: &str, text: &str, what: &str) -> Result<Vec<f64>> {
-    let values: Vec<f64> = parse_list(flag, text, "a number")?;
-    for v in &values {
-        if !(v.is_finite() && *v > 0.0) {
-            return Err(usage(format!(
-                "{flag} = {v} is not allowed: give {what} > 0"
-            )));
-        }
-    }
-    Ok(values)
-}
-
-/// The case text with `drum.rotation_period` replaced (the line in the `[drum]` table).
+/// The case text with `drum.rotation_period` replaced (`None`: the case does not set it).
+/// Everything else, comments and layout included, is kept as written.
 fn with_rotation_period(text: &str, period: f64) -> Option<String> {
-    let mut table = String::new();
-    let mut replaced = false;
-    let lines: Vec<String> = text
-        .lines()
-        .map(|line| {
-            let t = line.trim_start();
-            if t.starts_with('[') {
-                table = t.trim_end().to_string();
-            }
-            let key = t.split('=').next().unwrap_or("").trim();
-            if !replaced && table.starts_with("[drum]") && key == "rotation_period" {
-                replaced = true;
-                format!("rotation_period = {period:?} # set by tdex study regimes")
-            } else {
-                line.to_string()
-            }
-        })
-        .collect();
-    replaced.then(|| lines.join("\n") + "\n")
+    let mut doc: toml_edit::DocumentMut = text.parse().ok()?;
+    let value = doc
+        .get_mut("drum")?
+        .as_table_like_mut()?
+        .get_mut("rotation_period")?;
+    value.as_value()?;
+    let mut new = toml_edit::Value::from(period);
+    new.decor_mut().set_prefix(" ");
+    new.decor_mut().set_suffix(" # set by tdex study regimes");
+    *value = toml_edit::Item::Value(new);
+    Some(doc.to_string())
 }
 
 fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
-    let common_of = |c: &StudyCommon| -> Result<(usize, PathBuf)> {
-        let threads = threads(c.threads)?;
-        check_cells(c.cells)?;
-        Ok((threads, c.output.clone().unwrap_or_default()))
-    };
     let (common, kind_name) = match &study {
-        StudyCommand::Sampling { common, .. } => (common, "sampling"),
-        StudyCommand::Period { common, .. } => (common, "period"),
-        StudyCommand::Regimes { common, .. } => (common, "regimes"),
+        StudyCommand::Sampling { common, .. } => (common.clone(), "sampling"),
+        StudyCommand::Period { common, .. } => (common.clone(), "period"),
+        StudyCommand::Regimes { common, .. } => (common.clone(), "regimes"),
     };
-    let (threads, mut output) = common_of(common)?;
-    if output.as_os_str().is_empty() {
-        output = PathBuf::from(format!("tdex-study-{kind_name}"));
-    }
+    let output = common
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("tdex-study-{kind_name}")));
     check_output_dir(&output)?;
     let (case, case_toml) = recorder::case::load_with_text(&common.case)?;
-    let kind = match &study {
+    let kind = match study {
         StudyCommand::Sampling {
             n,
             dtc_max,
@@ -754,58 +631,45 @@ fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
             tau_rev,
             ..
         } => {
-            let ns = positive_steps("--n", n)?;
-            let dtcs = positive_steps("--dtc-max", dtc_max)?;
-            if *periods == 0 {
-                return Err(usage(
-                    "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
-                ));
-            }
+            let (ns, dtcs) = (distinct(n), distinct(dtc_max));
             let mut runs = Vec::new();
             let mut skipped = Vec::new();
             for &n in &ns {
-                for &d in &dtcs {
-                    if d % n != 0 {
-                        skipped.push((n, d));
+                for &dtc_max in &dtcs {
+                    if !dtc_max.is_multiple_of(n) {
+                        skipped.push((n, dtc_max));
                         continue;
                     }
                     runs.push(record_options(
                         &case,
-                        None,
-                        Some(*tau_rev),
-                        n,
-                        d,
-                        *periods,
-                        false,
+                        Tau::Revolutions(tau_rev),
+                        SamplingFlags { n, dtc_max },
+                        periods,
+                        AreaEncoding::Quantized,
                     )?);
                 }
             }
             if runs.is_empty() {
                 return Err(usage(format!(
-                    "--n {n} --dtc-max {dtc_max}: no Δt_c^max is a multiple of any n, so there is nothing to run"
+                    "--n {} --dtc-max {}: no Δt_c^max is a multiple of any n, so there is nothing to run",
+                    comma_separated(&ns),
+                    comma_separated(&dtcs)
                 )));
             }
             StudyKind::Sampling {
                 runs,
                 skipped,
-                tau_rev: *tau_rev,
+                tau_rev,
             }
         }
         StudyCommand::Period {
             tau_rev,
             revolutions,
-            n,
-            dtc_max,
+            sampling,
             ..
         } => {
-            let taus = positive_reals("--tau-rev", tau_rev, "fractions of a revolution")?;
-            if !(revolutions.is_finite() && *revolutions > 0.0) {
-                return Err(usage(format!(
-                    "--revolutions = {revolutions} is not allowed: give a number of revolutions > 0"
-                )));
-            }
             let mut runs = Vec::new();
-            for &f in &taus {
+            for f in distinct(tau_rev) {
                 let k = revolutions / f;
                 let periods = k.round();
                 if periods < 1.0 || (k - periods).abs() > 1e-9 * k {
@@ -816,36 +680,27 @@ fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
                 }
                 runs.push((
                     f,
-                    record_options(&case, None, Some(f), *n, *dtc_max, periods as u32, false)?,
+                    record_options(
+                        &case,
+                        Tau::Revolutions(f),
+                        sampling,
+                        periods as u32,
+                        AreaEncoding::Quantized,
+                    )?,
                 ));
             }
-            StudyKind::Period {
-                runs,
-                revolutions: *revolutions,
-            }
+            StudyKind::Period { runs, revolutions }
         }
         StudyCommand::Regimes {
             rev_period,
             periods,
             tau_rev,
-            n,
-            dtc_max,
+            sampling,
             min_relative,
             ..
         } => {
-            let speeds = positive_reals("--rev-period", rev_period, "rotation periods in seconds")?;
-            if *periods == 0 {
-                return Err(usage(
-                    "--periods = 0 is not allowed: extrapolate at least 1 period".into(),
-                ));
-            }
-            if !(min_relative.is_finite() && *min_relative >= 0.0) {
-                return Err(usage(format!(
-                    "--min-relative = {min_relative} is not allowed: give a fraction of the wall speed ≥ 0"
-                )));
-            }
             let mut runs = Vec::new();
-            for &t in &speeds {
+            for t in distinct(rev_period) {
                 let text = with_rotation_period(&case_toml, t).ok_or_else(|| {
                     usage(format!(
                         "{}: no `rotation_period = ...` line in its [drum] table to vary",
@@ -857,16 +712,14 @@ fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
                 let reference = if crate::study::flow::froude(&case_t) >= 1.0 {
                     0
                 } else {
-                    *periods
+                    periods
                 };
                 let options = record_options(
                     &case_t,
-                    None,
-                    Some(*tau_rev),
-                    *n,
-                    *dtc_max,
+                    Tau::Revolutions(tau_rev),
+                    sampling,
                     reference,
-                    false,
+                    AreaEncoding::Quantized,
                 )
                 .map_err(|e| usage(format!("--rev-period {t}: {e}")))?;
                 runs.push(RegimeRun {
@@ -878,19 +731,62 @@ fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
             }
             StudyKind::Regimes {
                 runs,
-                tau_rev: *tau_rev,
-                min_relative: *min_relative,
+                tau_rev,
+                min_relative,
             }
         }
     };
     Ok(StudyPlan {
-        case_path: common.case.clone(),
+        case_path: common.case,
         case_toml,
         case,
         output,
         cells: common.cells,
-        threads,
+        threads: workers(common.threads),
         json: common.json,
         kind,
     })
+}
+
+/// Values as a comma-separated list, as the flag takes them.
+fn comma_separated(values: &[u32]) -> String {
+    values
+        .iter()
+        .map(u32::to_string)
+        .collect::<Vec<_>>()
+        .join(",")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::with_rotation_period;
+
+    /// Every shipped case: only the rotation period's line changes, as the line-by-line
+    /// rewrite it replaces wrote it (checked byte for byte against it when it was replaced).
+    #[test]
+    fn rotation_period_replaced_in_place() {
+        let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/cases");
+        for entry in std::fs::read_dir(dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "toml") {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            for period in [15.0, 0.1, 2.5e-3] {
+                let new = with_rotation_period(&text, period).unwrap();
+                assert_eq!(new.lines().count(), text.lines().count());
+                let changed: Vec<_> = text
+                    .lines()
+                    .zip(new.lines())
+                    .filter(|(a, b)| a != b)
+                    .collect();
+                assert_eq!(changed.len(), 1, "{}", path.display());
+                assert_eq!(
+                    changed[0].1,
+                    format!("rotation_period = {period:?} # set by tdex study regimes")
+                );
+            }
+        }
+        assert!(with_rotation_period("[drum]\nradius = 0.1\n", 1.0).is_none());
+    }
 }

@@ -115,11 +115,11 @@ pub fn write_with(
     let extra_path = extrapolation.path().display().to_string();
 
     if extrapolation.info().recording_info != *info {
-        return Err(crate::cli::UsageError(format!(
-            "{extra_path} was not extrapolated from {rec_path} (it names {}, and the \
-             recordings' metadata differ)",
-            extrapolation.info().recording
-        ))
+        return Err(compare::CompareError::OtherRecording {
+            extrapolation: extra_path,
+            recording: rec_path,
+            names: extrapolation.info().recording.clone(),
+        }
         .into());
     }
     let dem = recording
