@@ -7,3 +7,11 @@
 pub mod compare;
 pub mod flow;
 pub mod fmt;
+
+/// Whose fault `error` is, if it is an error of any tdex library (the analyses here, the
+/// recorder, the extrapolation, the file format): how the command line picks its exit code.
+pub fn fault_of(error: &(dyn std::error::Error + 'static)) -> Option<tdex_format::Fault> {
+    tdex_format::fault_as::<compare::CompareError>(error)
+        .or_else(|| recorder::fault_of(error))
+        .or_else(|| extrapolate::fault_of(error))
+}

@@ -61,23 +61,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(err) => {
             eprintln!("error: {err:#}");
+            // the flags' own errors, or any library error that marks the input at fault
             let bad_input = |e: &(dyn std::error::Error + 'static)| {
-                e.is::<recorder::CaseError>()
-                    || e.is::<cli::UsageError>()
-                    || e.is::<extrapolate::replay::ReplayError>()
-                    || e.is::<extrapolate::pairing::PairingError>()
-                    || e.downcast_ref::<compare::CompareError>()
-                        .is_some_and(|f| f.is_bad_input())
-                    || e.downcast_ref::<extrapolate::ExtrapolateError>()
-                        .is_some_and(|f| f.is_bad_input())
-                    || e.downcast_ref::<recorder::format::FormatError>()
-                        .is_some_and(|f| f.is_bad_input())
-                    || e.downcast_ref::<recorder::import::ImportError>()
-                        .is_some_and(|f| f.is_bad_input())
-                    || e.downcast_ref::<recorder::record::CheckpointError>()
-                        .is_some_and(|f| f.is_bad_input())
-                    || e.downcast_ref::<recorder::record::RecordError>()
-                        .is_some_and(|f| f.is_bad_input())
+                e.is::<cli::UsageError>() || tdex::fault_of(e) == Some(tdex_format::Fault::Input)
             };
             if err.chain().any(bad_input) {
                 ExitCode::from(2)

@@ -5,7 +5,7 @@ use crate::pairing::PairingError;
 use crate::replay::ReplayError;
 use std::path::PathBuf;
 use tdex_format::output::OutputError;
-use tdex_format::FormatError;
+use tdex_format::{fault_as, Classify, Fault, FormatError};
 
 /// Why [`extrapolate_recording`](crate::extrapolate_recording) or the pairing cache failed.
 /// The wrapped errors read as they do on their own.
@@ -33,18 +33,39 @@ pub enum ExtrapolateError {
     Encode(#[from] serde_json::Error),
 }
 
-impl ExtrapolateError {
-    /// Whether the error is in the input the user gave (exit code 2), not in the run.
-    pub fn is_bad_input(&self) -> bool {
+impl Classify for ExtrapolateError {
+    fn fault(&self) -> Fault {
         match self {
-            ExtrapolateError::Format(e) => e.is_bad_input(),
+            ExtrapolateError::Format(e) => e.fault(),
             ExtrapolateError::Pairing(_)
             | ExtrapolateError::Replay(_)
-            | ExtrapolateError::Refused { .. } => true,
+            | ExtrapolateError::Refused { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)
-            | ExtrapolateError::Encode(_) => false,
+            | ExtrapolateError::Encode(_) => Fault::Run,
         }
     }
+}
+
+impl Classify for PairingError {
+    /// Snapshots that cannot be paired are the recording's fault.
+    fn fault(&self) -> Fault {
+        Fault::Input
+    }
+}
+
+impl Classify for ReplayError {
+    /// A table the replay refuses, or a pairing that does not fit it, is the input's fault.
+    fn fault(&self) -> Fault {
+        Fault::Input
+    }
+}
+
+/// The fault of `error` if it is one of this crate's errors or of the file format's.
+pub fn fault_of(error: &(dyn std::error::Error + 'static)) -> Option<Fault> {
+    fault_as::<ExtrapolateError>(error)
+        .or_else(|| fault_as::<PairingError>(error))
+        .or_else(|| fault_as::<ReplayError>(error))
+        .or_else(|| tdex_format::fault_of(error))
 }

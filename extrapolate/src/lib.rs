@@ -13,6 +13,6 @@ pub use driver::{
     extrapolate_recording, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice,
     TableChoice,
 };
-pub use error::ExtrapolateError;
+pub use error::{fault_of, ExtrapolateError};
 /// The pairing sidecar's format lives with the other files in `tdex-format`.
 pub use tdex_format::sidecar;

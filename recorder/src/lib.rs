@@ -28,6 +28,18 @@ pub mod slices;
 pub mod wall;
 
 pub use case::{Case, CaseError};
+
+/// The fault of `error` if it is one of the recorder's errors or of the file format's.
+pub fn fault_of(error: &(dyn std::error::Error + 'static)) -> Option<tdex_format::Fault> {
+    use tdex_format::fault_as;
+    fault_as::<CaseError>(error)
+        .or_else(|| fault_as::<SimulationError>(error))
+        .or_else(|| fault_as::<record::RecordError>(error))
+        .or_else(|| fault_as::<record::CheckpointError>(error))
+        .or_else(|| fault_as::<record::JournalError>(error))
+        .or_else(|| fault_as::<import::ImportError>(error))
+        .or_else(|| tdex_format::fault_of(error))
+}
 pub use simulation::{Simulation, SimulationError};
 /// The file contract lives in its own crate (`recorder/format`); these paths keep reading
 /// as before for the engine's own modules.

@@ -33,6 +33,14 @@ pub enum SimulationError {
     },
 }
 
+impl tdex_format::Classify for SimulationError {
+    /// A run that cannot insert its particles or blows up fails as a run (exit code 1),
+    /// though the case's parameters are the cause: the message names them.
+    fn fault(&self) -> tdex_format::Fault {
+        tdex_format::Fault::Run
+    }
+}
+
 /// Initial-temperature groups: the hot and cold halves of a split, by particle id.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Groups {

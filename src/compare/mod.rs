@@ -9,7 +9,7 @@ pub mod verdict;
 use floor::Field;
 use metrics::Cells;
 use serde::Serialize;
-use tdex_format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
+use tdex_format::{Classify, ExtrapolationReader, Fault, FormatError, RecordingReader, Snapshot};
 pub use verdict::Verdict;
 
 /// Default number of Voronoi cells (the paper's v = 200).
@@ -205,12 +205,13 @@ pub enum CompareError {
     },
 }
 
-impl CompareError {
-    /// Whether the inputs are at fault (exit code 2), not the machine.
-    pub fn is_bad_input(&self) -> bool {
+impl Classify for CompareError {
+    /// The inputs are at fault (files that do not belong together), unless reading a file
+    /// failed on the machine's side.
+    fn fault(&self) -> Fault {
         match self {
-            CompareError::Format(e) => e.is_bad_input(),
-            _ => true,
+            CompareError::Format(e) => e.fault(),
+            _ => Fault::Input,
         }
     }
 }

@@ -336,6 +336,40 @@ pub struct RecordingCosts {
     pub threads: usize,
 }
 
+/// Whose fault an error is: the input the user gave (a file, a case, a flag: exit code 2)
+/// or the run itself (a full disk, a failed write: exit code 1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Fault {
+    Input,
+    Run,
+}
+
+/// The one marker every library error of tdex carries: whose fault it is. Each library
+/// crate has a `fault_of` that finds it on any of its error types, which is how the
+/// command line chooses its exit code without knowing the types.
+pub trait Classify {
+    fn fault(&self) -> Fault;
+
+    /// Whether the input the user gave is at fault (exit code 2).
+    fn is_bad_input(&self) -> bool {
+        self.fault() == Fault::Input
+    }
+}
+
+/// The fault of `error` if it is an `E`.
+pub fn fault_as<E: Classify + std::error::Error + 'static>(
+    error: &(dyn std::error::Error + 'static),
+) -> Option<Fault> {
+    error.downcast_ref::<E>().map(Classify::fault)
+}
+
+/// The fault of `error` if it is one of this crate's errors.
+pub fn fault_of(error: &(dyn std::error::Error + 'static)) -> Option<Fault> {
+    fault_as::<FormatError>(error)
+        .or_else(|| fault_as::<output::OutputError>(error))
+        .or_else(|| fault_as::<sidecar::SidecarError>(error))
+}
+
 /// Why a recording cannot be written or read.
 #[derive(Debug, thiserror::Error)]
 pub enum FormatError {
@@ -387,12 +421,16 @@ impl FormatError {
             },
         }
     }
+}
 
-    /// Whether the error is in a file the user gave (exit code 2), not in writing one.
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(
-            self,
-            FormatError::Write { .. } | FormatError::Mcap { .. } | FormatError::Output(_)
-        )
+impl Classify for FormatError {
+    /// The input is at fault when the error is in a file the user gave, not in writing one.
+    fn fault(&self) -> Fault {
+        match self {
+            FormatError::Write { .. } | FormatError::Mcap { .. } | FormatError::Output(_) => {
+                Fault::Run
+            }
+            _ => Fault::Input,
+        }
     }
 }

@@ -30,6 +30,13 @@ pub struct OutputError {
     pub error: io::Error,
 }
 
+impl crate::Classify for OutputError {
+    /// An output that cannot be written is the run's fault, never the input's.
+    fn fault(&self) -> crate::Fault {
+        crate::Fault::Run
+    }
+}
+
 impl OutputError {
     /// An error while writing `dest` (through its temporary file).
     pub fn writing(dest: &Path, error: io::Error) -> Self {

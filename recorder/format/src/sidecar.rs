@@ -66,6 +66,13 @@ pub enum SidecarError {
     },
 }
 
+impl crate::Classify for SidecarError {
+    /// A sidecar that cannot be read or is not a pairing of the recording is bad input.
+    fn fault(&self) -> crate::Fault {
+        crate::Fault::Input
+    }
+}
+
 /// The sidecar of the recording `recording`: its path with `.pairing.json` appended.
 pub fn path_of(recording: &Path) -> PathBuf {
     let mut name = recording.as_os_str().to_owned();

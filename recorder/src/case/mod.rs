@@ -30,6 +30,13 @@ pub enum CaseError {
     },
 }
 
+impl tdex_format::Classify for CaseError {
+    /// A case that cannot be read or is refused is always the input's fault.
+    fn fault(&self) -> tdex_format::Fault {
+        tdex_format::Fault::Input
+    }
+}
+
 /// Reads, parses and validates a case file.
 pub fn load(path: &Path) -> Result<Case, CaseError> {
     load_with_text(path).map(|(case, _)| case)

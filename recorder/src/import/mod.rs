@@ -48,12 +48,12 @@ pub enum ImportError {
     Format(#[from] FormatError),
 }
 
-impl ImportError {
-    /// Whether the error is in the input (exit code 2), not in writing the recording.
-    pub fn is_bad_input(&self) -> bool {
+impl tdex_format::Classify for ImportError {
+    /// The input is at fault, unless writing the recording failed.
+    fn fault(&self) -> tdex_format::Fault {
         match self {
-            ImportError::Format(f) => f.is_bad_input(),
-            _ => true,
+            ImportError::Format(f) => tdex_format::Classify::fault(f),
+            _ => tdex_format::Fault::Input,
         }
     }
 }

@@ -151,10 +151,13 @@ pub enum CheckpointError {
     Inconsistent { path: PathBuf, detail: String },
 }
 
-impl CheckpointError {
-    /// Whether the error is in the file the user gave (exit code 2), not in writing one.
-    pub fn is_bad_input(&self) -> bool {
-        !matches!(self, CheckpointError::Write(_))
+impl tdex_format::Classify for CheckpointError {
+    /// The input is at fault in the checkpoint the user gave, not in writing one.
+    fn fault(&self) -> tdex_format::Fault {
+        match self {
+            CheckpointError::Write(_) => tdex_format::Fault::Run,
+            _ => tdex_format::Fault::Input,
+        }
     }
 }
 

@@ -5,6 +5,7 @@ use super::checkpoint::CheckpointError;
 use super::journal::JournalError;
 use crate::format::FormatError;
 use crate::SimulationError;
+use tdex_format::{Classify, Fault};
 
 #[derive(Debug, thiserror::Error)]
 pub enum RecordError {
@@ -28,20 +29,15 @@ pub enum RecordError {
     Journal(#[from] JournalError),
 }
 
-impl RecordError {
-    /// Whether the error is in a file the user gave (exit code 2): a checkpoint or its row
-    /// journal that cannot be resumed.
-    pub fn is_bad_input(&self) -> bool {
+impl Classify for RecordError {
+    /// The input is at fault in a file the user gave: a checkpoint or its row journal that
+    /// cannot be resumed.
+    fn fault(&self) -> Fault {
         match self {
-            RecordError::Checkpoint(e) => e.is_bad_input(),
-            RecordError::Journal(e) => {
-                matches!(
-                    e,
-                    JournalError::Short { .. } | JournalError::Mismatch { .. }
-                )
-            }
-            RecordError::Format(e) => e.is_bad_input(),
-            _ => false,
+            RecordError::Checkpoint(e) => e.fault(),
+            RecordError::Journal(e) => e.fault(),
+            RecordError::Format(e) => e.fault(),
+            _ => Fault::Run,
         }
     }
 }

@@ -58,6 +58,17 @@ pub enum JournalError {
     },
 }
 
+impl tdex_format::Classify for JournalError {
+    /// A journal that is not this run's, or was cut short, is the input's fault; failing
+    /// to read or write it is the run's.
+    fn fault(&self) -> tdex_format::Fault {
+        match self {
+            JournalError::Short { .. } | JournalError::Mismatch { .. } => tdex_format::Fault::Input,
+            _ => tdex_format::Fault::Run,
+        }
+    }
+}
+
 /// The journal open for appending.
 pub struct RowJournal {
     path: PathBuf,
