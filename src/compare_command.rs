@@ -3,8 +3,8 @@
 
 use crate::cli::{ComparePlan, UsageError};
 use anyhow::Result;
-use recorder::format::{ExtrapolationReader, FormatError, RecordingReader};
 use tdex::compare::{self, CompareError, Second};
+use tdex_format::{ExtrapolationReader, FormatError, RecordingReader};
 
 pub fn run(plan: &ComparePlan) -> Result<()> {
     let recording = match RecordingReader::open(&plan.recording) {

@@ -7,7 +7,7 @@ use crate::{compare, extrapolation, record, report};
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use extrapolate::{ExtrapolationRequest, TableChoice};
-use recorder::format::{AreaEncoding, ExtrapolationReader, RecordingReader};
+use tdex_format::{AreaEncoding, ExtrapolationReader, RecordingReader};
 
 /// The built-in case (the same text as `cases/small_drum.toml`).
 pub const CASE_TOML: &str = include_str!("../cases/small_drum.toml");
@@ -19,9 +19,9 @@ pub const TWINS: u32 = 1;
 pub fn run(plan: &DemoPlan) -> Result<()> {
     let began = std::time::Instant::now();
     let dir = &plan.output;
-    recorder::output::create_dir_all(dir)?;
+    tdex_format::output::create_dir_all(dir)?;
     let case_path = dir.join("small_drum.toml");
-    recorder::output::write_atomically(&case_path, CASE_TOML.as_bytes())?;
+    tdex_format::output::write_atomically(&case_path, CASE_TOML.as_bytes())?;
     let (case, case_toml) = recorder::case::load_with_text(&case_path)?;
     let recording = dir.join("run.mcap");
     let extra = dir.join("extra.mcap");

@@ -5,9 +5,9 @@
 use crate::cli::{ExportVtkPlan, UsageError};
 use anyhow::Result;
 use recorder::export::vtk::{self, ExtraArray};
-use recorder::format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
-use recorder::output::OutputSet;
 use std::path::{Path, PathBuf};
+use tdex_format::output::OutputSet;
+use tdex_format::{ExtrapolationReader, FormatError, RecordingReader, Snapshot};
 
 /// Name of the per-particle difference array of an extrapolation with its reference.
 pub const DIFFERENCE: &str = "dem_minus_extrapolated";
@@ -61,7 +61,7 @@ pub fn write(plan: &ExportVtkPlan) -> Result<Vec<PathBuf>> {
         .file
         .file_stem()
         .map_or("tdex".into(), |s| s.to_string_lossy().into_owned());
-    recorder::output::create_dir_all(&plan.output)?;
+    tdex_format::output::create_dir_all(&plan.output)?;
     let mut set = OutputSet::new();
     let mut series = Vec::new();
     for snap in &snapshots {

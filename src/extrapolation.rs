@@ -9,8 +9,8 @@ use extrapolate::sidecar::PairingSummary;
 use extrapolate::{
     ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice,
 };
-use recorder::format::ExtrapolationCosts;
 use serde::Serialize;
+use tdex_format::ExtrapolationCosts;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
 #[derive(Debug, Serialize)]

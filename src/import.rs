@@ -3,9 +3,9 @@
 use crate::cli::ImportPlan;
 use crate::inspect::Sampling;
 use anyhow::Result;
-use recorder::format::RecordingReader;
 use recorder::import::ImportError;
 use serde::Serialize;
+use tdex_format::RecordingReader;
 
 /// `tdex import liggghts --json` (keys documented in docs/user-guide.md).
 #[derive(Debug, Serialize)]

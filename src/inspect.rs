@@ -7,10 +7,10 @@ use crate::fmt;
 use anyhow::Result;
 use extrapolate::replay::{self, Bodies, CflRow};
 use extrapolate::sidecar::PairingSummary;
-use recorder::format::{
+use serde::Serialize;
+use tdex_format::{
     ExtrapolationCosts, ExtrapolationReader, FormatError, RecordingCosts, RecordingReader, Snapshot,
 };
-use serde::Serialize;
 
 /// Share of collisions that must last at least the suggested `n` steps (the paper's 97 %).
 const KEEP_FRACTION: f64 = 0.97;
@@ -52,7 +52,7 @@ pub struct Sampling {
 }
 
 impl Sampling {
-    pub fn of(info: &recorder::format::RecordingInfo) -> Self {
+    pub fn of(info: &tdex_format::RecordingInfo) -> Self {
         Self {
             particles: info.particles,
             dt: info.dt,
@@ -107,7 +107,7 @@ fn print_file(kind: &str, file: &str, bytes: u64, format_version: u32, tool_vers
 }
 
 /// The case's name as resolved into the recording ("" without one).
-fn case_name(info: &recorder::format::RecordingInfo) -> String {
+fn case_name(info: &tdex_format::RecordingInfo) -> String {
     info.case_resolved
         .get("name")
         .and_then(|v| v.as_str())
@@ -116,7 +116,7 @@ fn case_name(info: &recorder::format::RecordingInfo) -> String {
 }
 
 /// The walls held at a temperature.
-fn conducting_walls(info: &recorder::format::RecordingInfo) -> usize {
+fn conducting_walls(info: &tdex_format::RecordingInfo) -> usize {
     info.walls
         .iter()
         .filter(|w| w.temperature.is_some())
@@ -239,7 +239,7 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
     let info = reader.info().clone();
     let snapshots = reader.snapshots()?;
     let t0 = snapshots.iter().find(|s| s.index == 0).ok_or_else(|| {
-        recorder::format::FormatError::Corrupt {
+        tdex_format::FormatError::Corrupt {
             path: plan.file.clone(),
             detail: "no snapshot at t0 (index 0)".into(),
         }

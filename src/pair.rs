@@ -6,7 +6,7 @@ use crate::cli::PairPlan;
 use anyhow::Result;
 use extrapolate::cache::{compute, period_snapshots, store};
 use extrapolate::pairing;
-use recorder::format::RecordingReader;
+use tdex_format::RecordingReader;
 
 pub fn run(plan: &PairPlan) -> Result<()> {
     let reader = RecordingReader::open(&plan.file)?;

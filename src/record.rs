@@ -3,10 +3,10 @@
 use crate::cli::{RecordPlan, RecordStart};
 use crate::inspect::Sampling;
 use anyhow::{Context, Result};
-use recorder::format::RecordingReader;
 use recorder::record;
 use serde::Serialize;
 use std::collections::BTreeMap;
+use tdex_format::RecordingReader;
 
 /// `tdex record --json` (keys documented in docs/user-guide.md).
 #[derive(Debug, Serialize)]

@@ -359,7 +359,7 @@ fn a_recording_with_twins_killed_in_its_reference_and_twin_stages_resumes_to_the
     }
     resume_to_the_end(&ck_arg, &a, &b, &stops);
     // both twins are stored, differ from the DEM and from each other
-    let rec = recorder::format::RecordingReader::open(&a).unwrap();
+    let rec = tdex_format::RecordingReader::open(&a).unwrap();
     let twins = rec.twin_snapshots().unwrap();
     let dem = rec.snapshots().unwrap();
     assert_eq!(twins.len(), 2);

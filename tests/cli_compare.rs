@@ -3,8 +3,8 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use recorder::format::{ExtrapolationReader, RecordingReader};
 use std::path::{Path, PathBuf};
+use tdex_format::{ExtrapolationReader, RecordingReader};
 
 /// A tiny recording (τ = 0.25 rev, reference `reference` periods) and its extrapolation
 /// over `periods` periods.

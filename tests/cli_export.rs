@@ -4,9 +4,9 @@
 
 use crate::cli_compare::record_and_extrapolate;
 use crate::util::*;
-use recorder::format::{ExtrapolationReader, RecordingReader, Snapshot};
 use serde_json::json;
 use std::path::Path;
+use tdex_format::{ExtrapolationReader, RecordingReader, Snapshot};
 
 fn export(file: &Path, out: &Path, reference: Option<&Path>) -> std::process::Output {
     let mut args = vec![

@@ -5,9 +5,9 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use recorder::format::RecordingReader;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use tdex_format::RecordingReader;
 
 /// LIGGGHTS timestep of t0 in the hand-written dumps; τ = 30 steps, n = 10.
 const T0: u64 = 1000;
@@ -462,9 +462,9 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
     for path in pairs.iter().step_by(2) {
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
         {
-            let text = std::fs::read_to_string(&path).unwrap();
+            let text = std::fs::read_to_string(path).unwrap();
             gzip(&path.with_file_name(format!("{name}.gz")), &text);
-            std::fs::remove_file(&path).unwrap();
+            std::fs::remove_file(path).unwrap();
         }
     }
     let (run, extra) = (run_dir.join("run.mcap"), run_dir.join("extra.mcap"));

@@ -4,8 +4,8 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use recorder::format::{FormatError, RecordingReader};
 use std::path::{Path, PathBuf};
+use tdex_format::{FormatError, RecordingReader};
 
 /// The tiny drum with its mantle held at 350 K, so the table has wall rows.
 fn heated_case() -> String {

@@ -5,7 +5,7 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use recorder::format::ExtrapolationReader;
+use tdex_format::ExtrapolationReader;
 
 /// The plots of a split bed (no conducting wall) with a DEM reference.
 const PLOTS: [&str; 9] = [

@@ -4,8 +4,8 @@
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
-use recorder::format::RecordingReader;
 use std::path::{Path, PathBuf};
+use tdex_format::RecordingReader;
 
 fn write_case(dir: &Path) -> PathBuf {
     let case = dir.join("tiny.toml");

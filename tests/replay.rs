@@ -6,8 +6,8 @@ use crate::cli_run::TINY_CASE;
 use crate::util::*;
 use extrapolate::pairing::{pair, PairingOptions};
 use extrapolate::replay::{self, Bodies, Scheme, Table};
-use recorder::format::{RecordingReader, Snapshot};
 use std::path::Path;
+use tdex_format::{RecordingReader, Snapshot};
 
 fn record(dir: &Path, case_text: &str, flags: &[&str]) -> std::path::PathBuf {
     let case = dir.join("case.toml");

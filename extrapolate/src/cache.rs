@@ -1,5 +1,5 @@
 //! The pairing cache: the pairing of a recording's `t0` and `t1` snapshots, computed once and
-//! stored beside the recording ([`sidecar`](crate::sidecar)), reused while the snapshots'
+//! stored beside the recording ([`sidecar`]), reused while the snapshots'
 //! positions are the ones it was computed for.
 
 use crate::pairing::{self, PairingOptions};

@@ -1,12 +1,13 @@
 //! tdex recorder: case files, the thermal DEM engine of a rotating drum, the collision
-//! recorder and its file format, LIGGGHTS import and VTK export.
+//! recorder, LIGGGHTS import and VTK export. The files it writes are defined in the
+//! `tdex-format` crate (`recorder/format/`).
 //!
 //! Stages follow a DEM step: [`neighbor`] (cell grid, Verlet list), [`contact`] (one file per
 //! force law or pair kind), [`wall`], [`heat`] (conduction), [`integrate`], tied together by
 //! [`pipeline`]; [`counters`] times each stage. [`simulation`] drives a whole drum case.
-//! [`record`] samples the contacts into the table that [`format`] writes; [`import`] builds
-//! the same recording from LIGGGHTS dumps and [`export`] writes files for ParaView; every
-//! file goes through [`output`] (temporary file, fsync, rename).
+//! [`record`] samples the contacts into the table that `tdex_format::RecordingWriter` writes;
+//! [`import`] builds the same recording from LIGGGHTS dumps and [`export`] writes files for
+//! ParaView; every file goes through `tdex_format::output` (temporary file, fsync, rename).
 
 pub mod case;
 pub mod contact;
@@ -41,6 +42,3 @@ pub fn fault_of(error: &(dyn std::error::Error + 'static)) -> Option<tdex_format
         .or_else(|| tdex_format::fault_of(error))
 }
 pub use simulation::{Simulation, SimulationError};
-/// The file contract lives in its own crate (`recorder/format`); these paths keep reading
-/// as before for the engine's own modules.
-pub use tdex_format::{self as format, output};

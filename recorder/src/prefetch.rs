@@ -89,7 +89,7 @@ pub struct Prefetch {
 }
 
 impl Prefetch {
-    /// Adds elements `elements` of `array` (cut to its length; beyond [`MAX_RANGES`]
+    /// Adds elements `elements` of `array` (cut to its length; beyond `MAX_RANGES`
     /// ranges, ignored).
     pub fn add(&mut self, array: ArrayAddress, elements: Range<usize>) {
         let (start, end) = (elements.start.min(array.len), elements.end.min(array.len));

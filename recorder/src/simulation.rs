@@ -4,7 +4,6 @@
 use crate::case::{Case, EndCaps, TemperatureSpec};
 use crate::contact::PairLaw;
 use crate::counters::Counters;
-use crate::format::Snapshot;
 use crate::heat::ConductionLaw;
 use crate::insertion;
 use crate::math::{norm2, sub};
@@ -12,6 +11,7 @@ use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
 use crate::pipeline::{ContactCount, Pipeline, StepParams};
 use crate::wall::{WallMotion, WallSet};
+use tdex_format::Snapshot;
 
 /// Standard gravity along −z (m/s²).
 pub const GRAVITY: f64 = 9.81;

@@ -9,7 +9,7 @@ pub trait Sum: Send + Default + Add<Output = Self> {}
 impl<T: Send + Default + Add<Output = T>> Sum for T {}
 
 /// Mutable arrays that split together: a slice, a pair of them (nest pairs for more), or a
-/// struct of them (named fields; [`slices_indexed_alike!`] for slices indexed alike).
+/// struct of them (named fields; `slices_indexed_alike!` for slices indexed alike).
 pub trait Pieces: Sized + Send {
     /// A position in each array.
     type At: Copy + Send + Sync;

@@ -29,7 +29,7 @@ pub fn run(plan: &BenchPlan, dir: Option<&Path>) -> Result<PeerRate> {
         Some(d) => d.to_path_buf(),
         None => std::env::temp_dir().join(format!("tdex-bench-liggghts-{}", std::process::id())),
     };
-    recorder::output::create_dir_all(&dir)?;
+    tdex_format::output::create_dir_all(&dir)?;
     write_deck(&plan.case, &plan.case_path, plan.steps, &dir)?;
     let bar = crate::progress::spinner(
         plan.json,
@@ -93,7 +93,12 @@ fn last_loop_time(log: &str) -> Option<(f64, u64, u64)> {
 
 /// The first prime above `n` (LIGGGHTS wants prime seeds above 10 000).
 fn next_prime(mut n: u64) -> u64 {
-    let is_prime = |n: u64| n >= 2 && (2..).take_while(|d| d * d <= n).all(|d| n % d != 0);
+    let is_prime = |n: u64| {
+        n >= 2
+            && (2..)
+                .take_while(|d| d * d <= n)
+                .all(|d| !n.is_multiple_of(d))
+    };
     while !is_prime(n) {
         n += 1;
     }
@@ -138,7 +143,7 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
     };
     for (file, mantle, caps) in meshes {
         let path = dir.join(file);
-        recorder::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
+        tdex_format::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
     }
     let axis = split_axis.index();
     let ext = if axis == 1 { l / 2.0 + 0.01 } else { r + 0.01 };
@@ -245,7 +250,7 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
     }
     deck.push_str(rest);
     let path = dir.join("in.drum");
-    recorder::output::write_atomically(&path, deck.as_bytes())?;
+    tdex_format::output::write_atomically(&path, deck.as_bytes())?;
     Ok(())
 }
 

@@ -2,10 +2,10 @@
 
 use crate::cli::BenchRecordPlan;
 use anyhow::Result;
-use recorder::format::RecordingReader;
 use recorder::record::{self, Phase};
 use serde::Serialize;
 use std::time::Instant;
+use tdex_format::RecordingReader;
 
 /// Targets of issue 3: recording at most 1.15× a plain run, at most 6 bytes per row.
 const MAX_OVERHEAD: f64 = 1.15;

@@ -7,10 +7,10 @@ use super::args::{
 };
 use anyhow::Result;
 use extrapolate::replay::Scheme;
-use recorder::format::AreaEncoding;
 use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
+use tdex_format::AreaEncoding;
 
 /// Flags that do not fit the case or each other, or outputs that cannot be written
 /// (exit code 2). A CLI type: the libraries and analysis modules report bad input with their

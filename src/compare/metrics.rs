@@ -55,6 +55,10 @@ impl Cells {
         self.seeds.len()
     }
 
+    pub fn is_empty(&self) -> bool {
+        self.seeds.is_empty()
+    }
+
     /// The cell of each point (index of its nearest seed).
     pub fn assign(&self, points: &[[f64; 3]]) -> Vec<u32> {
         points
@@ -64,7 +68,7 @@ impl Cells {
                     .query(p)
                     .nearest_one::<SquaredEuclidean<f64>>()
                     .execute()
-                    .item as u32
+                    .item
             })
             .collect()
     }
@@ -126,7 +130,8 @@ pub fn energy_error(
 pub fn hot_cold_groups(temps_t0: &[f64]) -> Option<(Vec<u32>, Vec<u32>)> {
     let lo = temps_t0.iter().copied().fold(f64::INFINITY, f64::min);
     let hi = temps_t0.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    if !(hi > lo) {
+    // also None for NaN temperatures
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return None;
     }
     let mid = 0.5 * (lo + hi);

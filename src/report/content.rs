@@ -7,7 +7,7 @@ use super::document::{bold, code, link, para, text, Block, Document};
 use super::prediction::{Point, Prediction};
 use crate::compare::{Comparison, ContrastKind, PeriodComparison};
 use crate::fmt::trim_zeros;
-use recorder::format::{ExtrapolationInfo, RecordingInfo, RecordingSummary};
+use tdex_format::{ExtrapolationInfo, RecordingInfo, RecordingSummary};
 
 /// Columns of the error table before it continues in a second table.
 const COLUMNS_PER_TABLE: usize = 10;

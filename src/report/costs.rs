@@ -1,7 +1,7 @@
 //! The cost table in the form of the paper's Table 6: complete DEM against the extrapolated
 //! DEM for a number of periods, from the costs measured by `record` and `extrapolate`.
 
-use recorder::format::{ExtrapolationCosts, RecordingCosts};
+use tdex_format::{ExtrapolationCosts, RecordingCosts};
 
 /// Periods of the paper's Table 6.
 pub const TABLE_PERIODS: u32 = 100;

@@ -19,9 +19,9 @@ use content::{
 };
 use costs::CostTable;
 use prediction::{Measures, Prediction};
-use recorder::format::{ExtrapolationReader, RecordingReader};
-use recorder::output::OutputSet;
 use std::path::{Path, PathBuf};
+use tdex_format::output::OutputSet;
+use tdex_format::{ExtrapolationReader, RecordingReader};
 
 /// The report's own files; those of an older report that this one does not write again are
 /// removed once the new report is in place.
@@ -109,7 +109,7 @@ pub fn write_with(
     cells: usize,
     seed: u64,
 ) -> Result<Vec<PathBuf>> {
-    recorder::output::create_dir_all(dir)?;
+    tdex_format::output::create_dir_all(dir)?;
     let info = recording.info();
     let rec_path = recording.path().display().to_string();
     let extra_path = extrapolation.path().display().to_string();
@@ -203,7 +203,7 @@ pub fn write_with(
             plot(LACEY_SVG, plots::lacey(&pred, &dem_points))?,
         ));
     }
-    let panels: Vec<(&recorder::format::Snapshot, String)> = pred
+    let panels: Vec<(&tdex_format::Snapshot, String)> = pred
         .fields
         .iter()
         .map(|s| {

@@ -13,8 +13,8 @@ use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor;
-use recorder::format::Snapshot;
 use std::ops::Range;
+use tdex_format::Snapshot;
 
 pub(crate) const FONT: &str = "sans-serif";
 pub(crate) const SIZE: (u32, u32) = (820, 520);

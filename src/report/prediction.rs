@@ -6,7 +6,7 @@
 
 use crate::compare::metrics::{self, Cells};
 use anyhow::{Context, Result};
-use recorder::format::{RecordingInfo, Snapshot};
+use tdex_format::{RecordingInfo, Snapshot};
 
 /// Fewest particles per Voronoi cell, on average, that the Lacey index is computed on: with
 /// one or two particles in a cell the hot fraction of a cell is 0 or 1 whatever the mixing,

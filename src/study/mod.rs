@@ -16,12 +16,12 @@ use extrapolate::replay::Scheme;
 use extrapolate::{ExtrapolationRequest, TableChoice};
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
-use recorder::format::{ExtrapolationReader, RecordingReader};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
+use tdex_format::{ExtrapolationReader, RecordingReader};
 
 pub fn run(plan: &StudyPlan) -> Result<()> {
-    recorder::output::create_dir_all(&plan.output)?;
+    tdex_format::output::create_dir_all(&plan.output)?;
     match &plan.kind {
         StudyKind::Sampling {
             runs,
@@ -199,7 +199,7 @@ pub(crate) fn finish(
 
 /// Writes `dir/name` (through a temporary file renamed into place); returns its path.
 pub(crate) fn write_file(dir: &Path, name: &str, text: &str) -> Result<PathBuf> {
-    Ok(recorder::output::write_atomically(
+    Ok(tdex_format::output::write_atomically(
         &dir.join(name),
         text.as_bytes(),
     )?)

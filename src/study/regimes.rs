@@ -7,10 +7,10 @@ use super::flow::{self, Regime};
 use super::{evaluate, num, pct, plots, run_paths, write_file, Outcome};
 use crate::cli::{RegimeRun, StudyPlan};
 use anyhow::{Context, Result};
-use recorder::format::RecordingReader;
 use recorder::record;
 use serde::Serialize;
 use std::time::Instant;
+use tdex_format::RecordingReader;
 
 #[derive(Debug, Serialize)]
 struct Entry {

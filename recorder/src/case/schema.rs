@@ -161,7 +161,7 @@ pub struct TimeSpec {
 
 /// Initial temperatures assigned at `t0`: the mode selects the fields it needs.
 ///
-/// Read and written through [`TemperatureFields`], the `[temperature]` table as the file
+/// Read and written through `TemperatureFields`, the `[temperature]` table as the file
 /// spells it, so a file names the mode with `mode = "…"` and a recording's resolved case
 /// keeps today's keys (every field, `null` where the mode has none).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -72,8 +72,9 @@ fn scan_entries(
     let (mut touching, mut touched_before) = (0, 0);
     for i in slots.clone() {
         let (pos_i, radius_i) = (pos[i], radius[i]);
-        for e in offsets[i] as usize..offsets[i + 1] as usize {
-            let j = partners[e] as usize;
+        let (first, last) = (offsets[i] as usize, offsets[i + 1] as usize);
+        for (e, &partner) in (first..last).zip(&partners[first..last]) {
+            let j = partner as usize;
             let delta = sub(pos_i, pos[j]);
             let local = e - first_entry;
             let old = if touch[local] { touched_before } else { fresh };

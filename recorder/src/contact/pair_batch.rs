@@ -141,6 +141,11 @@ impl PairBatch {
     /// Adds the lanes of `hit` among 8 entries of `owner` (partner slots, old history
     /// indices, centre distances `delta` and their squared lengths `r2`), keeping their
     /// order; true when the batch is full. The batch must not be full before.
+    ///
+    /// # Safety
+    ///
+    /// The CPU must have AVX-512F and AVX-512VL (the caller checks with
+    /// `is_x86_feature_detected!` before taking this path).
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512vl")]
     #[inline]

@@ -1,8 +1,8 @@
 //! VTK XML files for ParaView: a snapshot as PolyData (`.vtp`, ASCII, one vertex per
 //! particle) and a time series of them as a collection (`.pvd`).
 
-use crate::format::Snapshot;
 use std::fmt::Write;
+use tdex_format::Snapshot;
 
 /// A per-particle value written besides the snapshot's own fields (one component).
 pub struct ExtraArray<'a> {

@@ -6,12 +6,12 @@
 use super::dump::{DumpSet, FramePart, Items};
 use super::ImportError;
 use crate::case::{Case, ContactArea, EndCaps};
-use crate::format::{RecordingCosts, RecordingSummary, RecordingWriter, Snapshot};
 use crate::heat::ConductionLaw;
 use crate::record::metadata::{recording_info, wall_infos, RunAtT0};
 use crate::record::{ContactSampler, RecordOptions};
 use crate::wall::{WallMotion, WallSet};
 use std::path::{Path, PathBuf};
+use tdex_format::{RecordingCosts, RecordingSummary, RecordingWriter, Snapshot};
 
 /// The dump file patterns (wildcards in the file name: `*`, `%`, `?`).
 #[derive(Debug, Clone)]
@@ -212,7 +212,7 @@ fn snapshots_of(
     let mut skipped = 0;
     while let Some(step) = set.next_timestep() {
         let k = (step - step_t0) / period;
-        let wanted = (step - step_t0) % period == 0 && k == snapshots.len() as u64;
+        let wanted = (step - step_t0).is_multiple_of(period) && k == snapshots.len() as u64;
         let (_, parts) = set.read_next(!wanted)?.expect("a frame is next");
         if !wanted {
             skipped += 1;

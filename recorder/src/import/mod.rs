@@ -3,8 +3,8 @@
 pub mod dump;
 pub mod liggghts;
 
-use crate::format::FormatError;
 use std::path::PathBuf;
+use tdex_format::FormatError;
 
 /// Why dumps cannot be imported; every message names the file (and line) at fault.
 #[derive(Debug, thiserror::Error)]

@@ -19,7 +19,6 @@ use super::options::RecordOptions;
 use super::ContactSampler;
 use crate::case::Case;
 use crate::counters::Counters;
-use crate::format::Snapshot;
 use crate::neighbor::NeighborList;
 use crate::particles::ParticleSet;
 use crate::pipeline::ContactCount;
@@ -29,6 +28,7 @@ use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use tdex_format::Snapshot;
 
 /// Format of the body; a reader refuses others. v2: the Verlet list's pair histories are
 /// packed layer by layer (v1 had one per entry). v3: one stage timer for pair and wall
@@ -138,7 +138,7 @@ pub enum CheckpointError {
         error: std::io::Error,
     },
     #[error("checkpoint {0}")]
-    Write(#[from] crate::output::OutputError),
+    Write(#[from] tdex_format::output::OutputError),
     #[error("{}: not a tdex checkpoint (its first line does not start with '{HEADER_PREFIX}')", path.display())]
     NotCheckpoint { path: PathBuf },
     #[error("{}: checkpoint format v{found}; this tdex reads v{CHECKPOINT_VERSION}", path.display())]
@@ -166,9 +166,10 @@ impl Checkpoint<'_> {
     /// renamed over the previous checkpoint, and the directory synced. `header` is the text
     /// after the version on the first line.
     pub fn write(&self, path: &Path, header: &str) -> Result<(), CheckpointError> {
-        let body = postcard::to_stdvec(self)
-            .map_err(|e| crate::output::OutputError::writing(path, std::io::Error::other(e)))?;
-        crate::output::write_with(path, |file| {
+        let body = postcard::to_stdvec(self).map_err(|e| {
+            tdex_format::output::OutputError::writing(path, std::io::Error::other(e))
+        })?;
+        tdex_format::output::write_with(path, |file| {
             let line = format!(
                 "{HEADER_PREFIX}{CHECKPOINT_VERSION}: {}\n",
                 header.replace('\n', " ")

@@ -11,11 +11,11 @@ use super::period::{record_period, PeriodCheckpoint, RecorderState, RowSink};
 use super::saver::Saver;
 use super::ContactSampler;
 use crate::case::Case;
-use crate::format::{RecordingSummary, RecordingWriter, Snapshot};
 use crate::Simulation;
 use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
+use tdex_format::{RecordingSummary, RecordingWriter, Snapshot};
 
 /// Runs the case and writes the recording to `dest`. `case_toml` is the case file as given.
 pub fn record(
@@ -80,8 +80,8 @@ pub fn resume(
     };
     let restored = checkpoint.restore(case, path)?;
     // temporary files of the killed run (its output, a checkpoint it was writing)
-    crate::output::remove_stale_temps(&dest);
-    crate::output::remove_stale_temps(path);
+    tdex_format::output::remove_stale_temps(&dest);
+    tdex_format::output::remove_stale_temps(path);
     let saver = Saver::new(&run, path, run.checkpoint_every.expect("set above"))?;
     let start = Start::Restored(Box::new(restored));
     drive_one(&run, start, Some(saver), progress)
@@ -224,13 +224,13 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
             opts.period_steps
         )));
     }
-    if opts.twins > crate::format::MAX_TWINS || (opts.twins > 0 && opts.reference_periods == 0) {
+    if opts.twins > tdex_format::MAX_TWINS || (opts.twins > 0 && opts.reference_periods == 0) {
         return Err(RecordError::Settings(format!(
             "{} DEM twins with {} reference periods: twins run over the reference periods, so \
              they need at least one, and at most {} twins are recorded",
             opts.twins,
             opts.reference_periods,
-            crate::format::MAX_TWINS
+            tdex_format::MAX_TWINS
         )));
     }
     ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {

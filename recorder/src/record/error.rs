@@ -3,8 +3,8 @@
 
 use super::checkpoint::CheckpointError;
 use super::journal::JournalError;
-use crate::format::FormatError;
 use crate::SimulationError;
+use tdex_format::FormatError;
 use tdex_format::{Classify, Fault};
 
 #[derive(Debug, thiserror::Error)]

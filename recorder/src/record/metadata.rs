@@ -3,16 +3,16 @@
 
 use super::options::RecordOptions;
 use crate::case::Case;
-use crate::format::{
-    AreaEncoding, RecordingCosts, RecordingInfo, WallInfo, WallKind, FORMAT_VERSION,
-    SQRT_AREA_CODES,
-};
 use crate::heat::ConductionLaw;
 use crate::wall::WallSet;
 use crate::Simulation;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
+use tdex_format::{
+    AreaEncoding, RecordingCosts, RecordingInfo, WallInfo, WallKind, FORMAT_VERSION,
+    SQRT_AREA_CODES,
+};
 
 /// What a recording's info takes from the run at `t0`, whichever engine made it.
 #[derive(Debug, Clone, Serialize, Deserialize)]

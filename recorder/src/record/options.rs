@@ -2,8 +2,8 @@
 //! checkpoint interval) and the phases its progress reports name.
 
 use crate::case::Case;
-use crate::format::AreaEncoding;
 use std::path::Path;
+use tdex_format::AreaEncoding;
 
 /// What to record, validated by the caller (the CLI plan).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -5,10 +5,10 @@ use super::error::RecordError;
 use super::journal::{JournalMark, RowJournal};
 use super::options::{Phase, REPORT_EVERY};
 use super::{CollisionRow, ContactSampler};
-use crate::format::RecordingWriter;
 use crate::Simulation;
 use std::sync::mpsc;
 use std::time::Instant;
+use tdex_format::RecordingWriter;
 
 /// A recording's writer and, when the run is checkpointed, its row journal.
 pub(super) struct RowSink {

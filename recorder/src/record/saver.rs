@@ -41,7 +41,7 @@ impl<'a> Saver<'a> {
             })?;
         let absolute = |p: &Path| {
             std::path::absolute(p).map_err(|error| {
-                CheckpointError::from(crate::output::OutputError::writing(p, error))
+                CheckpointError::from(tdex_format::output::OutputError::writing(p, error))
             })
         };
         Ok(Self {
