@@ -211,6 +211,15 @@ fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_cou
         files[0] == files[1],
         "the extrapolation depends on the threads"
     );
+    // the pairing stored by the last run, read back and reused: the same bytes again (the
+    // sidecar's floats read back to the bit)
+    let reused = dir.path().join("reused.mcap");
+    let o = extrapolate(&run, &reused, &["--reproducible"]);
+    assert_eq!(json_of(&o)["costs"]["pairing_reused"], true);
+    assert!(
+        std::fs::read(&reused).unwrap() == files[0],
+        "an extrapolation with a reused pairing differs from one that computed it"
+    );
     let costs = b"tdex.extrapolation_costs";
     assert!(!files[0].windows(costs.len()).any(|w| w == costs));
     // without the flag the file holds the costs record
