@@ -9,10 +9,10 @@ use crate::counters::{timed, Counters};
 use crate::heat::ConductionLaw;
 use crate::integrate;
 use crate::math::*;
-use crate::neighbor::{CellGrid, NeighborList};
+use crate::neighbor::{CellGrid, ListPieces, NeighborList};
 use crate::particles::ParticleSet;
 use crate::prefetch::{self, ArrayAddress, Prefetch};
-use crate::slices::{for_each_task, slices_indexed_alike, Pieces};
+use crate::slices::{for_each_task, pieces_at, slices_indexed_alike};
 use crate::wall::WallSet;
 use std::cell::RefCell;
 use std::ops::Range;
@@ -453,26 +453,11 @@ struct TaskStart {
     wall_candidate: usize,
 }
 
-impl Pieces for TaskPieces<'_> {
-    type At = TaskStart;
-    fn split(self, from: TaskStart, at: TaskStart) -> (Self, Self) {
-        let (sums0, sums1) = self.sums.split(from.slot, at.slot);
-        let (pairs0, pairs1) = self.pairs.split(from.pair_entry, at.pair_entry);
-        let (walls0, walls1) = self.walls.split(from.wall_candidate, at.wall_candidate);
-        (
-            TaskPieces {
-                sums: sums0,
-                pairs: pairs0,
-                walls: walls0,
-            },
-            TaskPieces {
-                sums: sums1,
-                pairs: pairs1,
-                walls: walls1,
-            },
-        )
-    }
-}
+pieces_at!(TaskPieces at TaskStart {
+    sums: slot,
+    pairs: pair_entry,
+    walls: wall_candidate
+});
 
 /// The force, torque and heat flow each particle of a task's slots receives from its
 /// contacts.
@@ -486,17 +471,6 @@ slices_indexed_alike!(Sums {
     force,
     torque,
     heat_flow
-});
-
-/// Histories and touching flags of a task's list entries.
-struct ListPieces<'a> {
-    histories: &'a mut [ContactHistory],
-    touching: &'a mut [bool],
-}
-
-slices_indexed_alike!(ListPieces {
-    histories,
-    touching
 });
 
 /// Where the arrays a pair task reads lie, for prefetching the next task's part of them.

@@ -8,8 +8,9 @@ pub trait Sum: Send + Default + Add<Output = Self> {}
 
 impl<T: Send + Default + Add<Output = T>> Sum for T {}
 
-/// Mutable arrays that split together: a slice, a pair of them (nest pairs for more), or a
-/// struct of them (named fields; `slices_indexed_alike!` for slices indexed alike).
+/// Mutable arrays that split together: a slice, a pair of them, or a struct of them (named
+/// fields: `slices_indexed_alike!` for slices indexed alike, `pieces_at!` for pieces split at
+/// positions of their own).
 pub trait Pieces: Sized + Send {
     /// A position in each array.
     type At: Copy + Send + Sync;
@@ -47,6 +48,22 @@ macro_rules! slices_indexed_alike {
     };
 }
 pub(crate) use slices_indexed_alike;
+
+/// Implements [`Pieces`] for a struct of pieces split at positions of their own, named by the
+/// fields of a struct of positions: `pieces_at!(Name at Start { field: position, … })`, the
+/// pieces struct taking one lifetime, the fields split in the order given.
+macro_rules! pieces_at {
+    ($name:ident at $start:ident { $($field:ident: $at:ident),+ $(,)? }) => {
+        impl $crate::slices::Pieces for $name<'_> {
+            type At = $start;
+            fn split(self, from: $start, at: $start) -> (Self, Self) {
+                $(let $field = $crate::slices::Pieces::split(self.$field, from.$at, at.$at);)+
+                ($name { $($field: $field.0),+ }, $name { $($field: $field.1),+ })
+            }
+        }
+    };
+}
+pub(crate) use pieces_at;
 
 /// Runs `work(task, pieces)` for every task of `tasks`, in parallel, and sums the results
 /// (from `R::default()`).
@@ -124,5 +141,51 @@ mod tests {
             ]
         );
         assert_eq!(a, vec![0, 0, 2, 0, 4, 0, 6, 0, 8, 9]);
+    }
+
+    /// Named pieces split at named positions, as the tasks of the list and contact stages.
+    struct Named<'a> {
+        a: &'a mut [u32],
+        b: &'a mut [u32],
+    }
+
+    #[derive(Debug, Clone, Copy, Default)]
+    struct NamedAt {
+        in_a: usize,
+        in_b: usize,
+    }
+
+    pieces_at!(Named at NamedAt { a: in_a, b: in_b });
+
+    #[test]
+    fn named_pieces_split_at_their_own_positions() {
+        let mut a: Vec<u32> = (0..10).collect();
+        let mut b: Vec<u32> = (100..120).collect();
+        // task k owns a[3k ..] and b[5k ..], up to the next task's start
+        let seen = std::sync::Mutex::new(Vec::new());
+        let start = |k: usize| NamedAt {
+            in_a: 3 * k,
+            in_b: 5 * k,
+        };
+        let total: u64 = for_each_task(
+            Named {
+                a: &mut a[..],
+                b: &mut b[..],
+            },
+            NamedAt::default(),
+            1..4,
+            &start,
+            &|k, Named { a, b }: Named| {
+                seen.lock().unwrap().push((k, a[0], a.len(), b[0], b.len()));
+                1
+            },
+        );
+        assert_eq!(total, 3);
+        let mut seen = seen.into_inner().unwrap();
+        seen.sort();
+        assert_eq!(
+            seen,
+            vec![(1, 3, 3, 105, 5), (2, 6, 3, 110, 5), (3, 9, 1, 115, 5)]
+        );
     }
 }

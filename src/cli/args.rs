@@ -27,174 +27,26 @@ pub struct Cli {
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Run a case: insert, settle, spin up, assign temperatures at t0 and heat; print a summary.
-    Run {
-        /// The case file (TOML).
-        case: PathBuf,
-        /// Worker threads (default: all cores). Results do not depend on it.
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Run(RunArgs),
     /// Record one period: run the case to t0, assign temperatures, record the sampled
     /// collision table and the snapshots at t0 and t1 (and K reference periods) into MCAP.
-    Record {
-        /// The case file (TOML).
-        #[arg(required_unless_present = "resume")]
-        case: Option<PathBuf>,
-        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-        /// Required (`tdex record --resume` takes it from the checkpoint).
-        #[arg(short = 'o', long = "output", required_unless_present = "resume")]
-        output: Option<PathBuf>,
-        #[command(flatten)]
-        recording: RecordingFlags,
-        /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
-        #[arg(long, default_value_t = 0)]
-        reference: u32,
-        /// Also continue M more DEM runs ("twins") from the state at t1 over the same K
-        /// reference periods, twin m with the drum's angular velocity changed by m units in
-        /// its last place: the DEM's own run-to-run spread, against which `compare` and
-        /// `report` judge the extrapolation. Each twin costs the reference periods again.
-        #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16), requires = "reference")]
-        twins: u32,
-        /// Worker threads (default: all cores). The recording does not depend on it.
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-        /// Every SECONDS of wall time, save the whole state of the run (atomically) to
-        /// OUTPUT.checkpoint, with the table rows so far in OUTPUT.checkpoint.rows; both are
-        /// removed when the recording is complete.
-        #[arg(
-            long = "checkpoint-every",
-            value_name = "SECONDS",
-            value_parser = positive("give the seconds of wall time between checkpoints, > 0")
-        )]
-        checkpoint_every: Option<f64>,
-        /// Continue the run a checkpoint was taken in: `tdex record --resume
-        /// OUTPUT.checkpoint`. The recording is the one the run would have written without
-        /// the interruption, byte for byte up to its costs record.
-        #[arg(
-            long,
-            value_name = "CHECKPOINT",
-            conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "reproducible"]
-        )]
-        resume: Option<PathBuf>,
-        /// Leave out the costs record (wall times, thread count): the same case, seed and
-        /// flags then give the same file byte for byte, resumed or not.
-        #[arg(long)]
-        reproducible: bool,
-    },
+    Record(RecordArgs),
     /// Pair the t0 and t1 snapshots of a recording (minimum total distance, certified
     /// optimal) and store the pairing beside it (RECORDING.pairing.json) for reuse.
-    Pair {
-        /// The recording (MCAP).
-        file: PathBuf,
-        /// Worker threads (default: all cores). The pairing does not depend on it.
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-        /// Leave the time and thread count out of the stored pairing: the same recording
-        /// then gives the same file byte for byte.
-        #[arg(long)]
-        reproducible: bool,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Pair(PairArgs),
     /// Extrapolate K periods: replay the recorded table through the pairing, writing the
     /// extrapolated temperature and position of every particle at every t_k (MCAP).
-    Extrapolate {
-        /// The recording (MCAP).
-        file: PathBuf,
-        /// Periods to extrapolate after t1.
-        #[arg(long, value_parser = periods())]
-        periods: u32,
-        /// The extrapolation to write (MCAP).
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// How the rows update the temperatures.
-        #[arg(long, value_enum, default_value_t = Scheme::Explicit)]
-        scheme: Scheme,
-        /// Read the table from the file every period instead of keeping it in memory.
-        #[arg(long)]
-        stream: bool,
-        /// Memory the extrapolation may use, e.g. 512M, 4G (K, M, G, T: powers of 1024); a
-        /// table that does not fit is streamed from the file. Default: 80 % of MemAvailable
-        /// (and of what the cgroup still allows).
-        #[arg(long = "max-memory", value_name = "SIZE", value_parser = Size)]
-        max_memory: Option<u64>,
-        /// Worker threads (default: all cores).
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-        /// Leave the costs record (wall times, thread count) out of the extrapolation: the
-        /// same recording and flags then give the same file byte for byte.
-        #[arg(long)]
-        reproducible: bool,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Extrapolate(ExtrapolateArgs),
     /// Compare an extrapolation with the recording's DEM reference at every t_k: Voronoi-cell
     /// errors (eps_abs, eps_rel), the Eq. 10 energy-transfer error, hot/cold group means.
     /// Given a second recording instead, compare two DEM runs of one case the same way.
-    Compare {
-        /// The recording, made with --reference K.
-        recording: PathBuf,
-        /// The extrapolation of that recording; or a second DEM run of the same case, recorded
-        /// with a reference over the same t_k (another seed, a perturbed case, a LIGGGHTS
-        /// import), to see how far apart two DEM runs are on the same measures.
-        extrapolation: PathBuf,
-        /// Voronoi cells (seeds drawn inside the bed).
-        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
-        cells: usize,
-        /// Seed of the cell centres.
-        #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
-        seed: u64,
-        /// Print the comparison as one JSON object on stdout.
-        #[arg(long, conflicts_with = "csv")]
-        json: bool,
-        /// Print one CSV line per t_k on stdout.
-        #[arg(long)]
-        csv: bool,
-        /// A further DEM run of the same case over the same t_k (a recording: another
-        /// engine's run imported, a perturbed case), added to the recording's own twins to
-        /// measure the DEM's run-to-run spread. Repeatable.
-        #[arg(long = "dem-run", value_name = "RECORDING")]
-        dem_runs: Vec<PathBuf>,
-    },
+    Compare(CompareArgs),
     /// Write a self-contained report (report.md, report.html, SVG plots) of an extrapolation
     /// against its recording: the error table, the cost table for 100 periods, plots.
-    Report {
-        /// The recording, made with --reference K.
-        recording: PathBuf,
-        /// The extrapolation of that recording.
-        extrapolation: PathBuf,
-        /// The report directory (created if missing; files in it are replaced).
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// A further DEM run of the same case over the same t_k, added to the recording's
-        /// own twins to measure the DEM's run-to-run spread (as `compare --dem-run`).
-        #[arg(long = "dem-run", value_name = "RECORDING")]
-        dem_runs: Vec<PathBuf>,
-        /// Voronoi cells (seeds drawn inside the bed).
-        #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
-        cells: usize,
-        /// Seed of the cell centres.
-        #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
-        seed: u64,
-    },
+    Report(ReportArgs),
     /// The method end to end on the built-in small drum (2 000 particles): record one
     /// revolution with a 6-period DEM reference, extrapolate 6 periods, compare, report.
-    Demo {
-        /// Directory for the case, the recording, the extrapolation and the report.
-        #[arg(short = 'o', long = "output", default_value = "tdex-demo")]
-        output: PathBuf,
-        /// Worker threads (default: all cores). Results do not depend on it.
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-    },
+    Demo(DemoArgs),
     /// Benchmarks (figures for docs/benchmarks.md): `tdex bench CASE` times the DEM engine
     /// on the rotating, heated phase of a case (optionally against LIGGGHTS in the same run);
     /// `tdex bench record CASE` the recording overhead.
@@ -212,13 +64,193 @@ pub enum Command {
     /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
     /// suggested n, costs. Reads the whole table, so it also checks the file. Given an
     /// extrapolation: its recording, periods, scheme, pairing and heat balance.
-    Inspect {
-        /// The recording or extrapolation (MCAP).
-        file: PathBuf,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Inspect(InspectArgs),
+}
+
+/// `tdex run`.
+#[derive(Debug, clap::Args)]
+pub struct RunArgs {
+    /// The case file (TOML).
+    pub case: PathBuf,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `tdex record`: a new recording, or `--resume` of a checkpointed one.
+#[derive(Debug, clap::Args)]
+pub struct RecordArgs {
+    /// The case file (TOML).
+    #[arg(required_unless_present = "resume")]
+    pub case: Option<PathBuf>,
+    /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+    /// Required (`tdex record --resume` takes it from the checkpoint).
+    #[arg(short = 'o', long = "output", required_unless_present = "resume")]
+    pub output: Option<PathBuf>,
+    #[command(flatten)]
+    pub recording: RecordingFlags,
+    /// Continue the DEM K periods after t1, storing a reference snapshot at every t_k.
+    #[arg(long, default_value_t = 0)]
+    pub reference: u32,
+    /// Also continue M more DEM runs ("twins") from the state at t1 over the same K
+    /// reference periods, twin m with the drum's angular velocity changed by m units in
+    /// its last place: the DEM's own run-to-run spread, against which `compare` and
+    /// `report` judge the extrapolation. Each twin costs the reference periods again.
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16), requires = "reference")]
+    pub twins: u32,
+    /// Worker threads (default: all cores). The recording does not depend on it.
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+    /// Every SECONDS of wall time, save the whole state of the run (atomically) to
+    /// OUTPUT.checkpoint, with the table rows so far in OUTPUT.checkpoint.rows; both are
+    /// removed when the recording is complete.
+    #[arg(
+        long = "checkpoint-every",
+        value_name = "SECONDS",
+        value_parser = positive("give the seconds of wall time between checkpoints, > 0")
+    )]
+    pub checkpoint_every: Option<f64>,
+    /// Continue the run a checkpoint was taken in: `tdex record --resume
+    /// OUTPUT.checkpoint`. The recording is the one the run would have written without
+    /// the interruption, byte for byte up to its costs record.
+    #[arg(
+        long,
+        value_name = "CHECKPOINT",
+        conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "reproducible"]
+    )]
+    pub resume: Option<PathBuf>,
+    /// Leave out the costs record (wall times, thread count): the same case, seed and
+    /// flags then give the same file byte for byte, resumed or not.
+    #[arg(long)]
+    pub reproducible: bool,
+}
+
+/// `tdex pair`.
+#[derive(Debug, clap::Args)]
+pub struct PairArgs {
+    /// The recording (MCAP).
+    pub file: PathBuf,
+    /// Worker threads (default: all cores). The pairing does not depend on it.
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+    /// Leave the time and thread count out of the stored pairing: the same recording
+    /// then gives the same file byte for byte.
+    #[arg(long)]
+    pub reproducible: bool,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `tdex extrapolate`.
+#[derive(Debug, clap::Args)]
+pub struct ExtrapolateArgs {
+    /// The recording (MCAP).
+    pub file: PathBuf,
+    /// Periods to extrapolate after t1.
+    #[arg(long, value_parser = periods())]
+    pub periods: u32,
+    /// The extrapolation to write (MCAP).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// How the rows update the temperatures.
+    #[arg(long, value_enum, default_value_t = Scheme::Explicit)]
+    pub scheme: Scheme,
+    /// Read the table from the file every period instead of keeping it in memory.
+    #[arg(long)]
+    pub stream: bool,
+    /// Memory the extrapolation may use, e.g. 512M, 4G (K, M, G, T: powers of 1024); a
+    /// table that does not fit is streamed from the file. Default: 80 % of MemAvailable
+    /// (and of what the cgroup still allows).
+    #[arg(long = "max-memory", value_name = "SIZE", value_parser = Size)]
+    pub max_memory: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+    /// Leave the costs record (wall times, thread count) out of the extrapolation: the
+    /// same recording and flags then give the same file byte for byte.
+    #[arg(long)]
+    pub reproducible: bool,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `tdex compare`.
+#[derive(Debug, clap::Args)]
+pub struct CompareArgs {
+    /// The recording, made with --reference K.
+    pub recording: PathBuf,
+    /// The extrapolation of that recording; or a second DEM run of the same case, recorded
+    /// with a reference over the same t_k (another seed, a perturbed case, a LIGGGHTS
+    /// import), to see how far apart two DEM runs are on the same measures.
+    pub extrapolation: PathBuf,
+    /// Voronoi cells (seeds drawn inside the bed).
+    #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
+    pub cells: usize,
+    /// Seed of the cell centres.
+    #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
+    pub seed: u64,
+    /// Print the comparison as one JSON object on stdout.
+    #[arg(long, conflicts_with = "csv")]
+    pub json: bool,
+    /// Print one CSV line per t_k on stdout.
+    #[arg(long)]
+    pub csv: bool,
+    /// A further DEM run of the same case over the same t_k (a recording: another
+    /// engine's run imported, a perturbed case), added to the recording's own twins to
+    /// measure the DEM's run-to-run spread. Repeatable.
+    #[arg(long = "dem-run", value_name = "RECORDING")]
+    pub dem_runs: Vec<PathBuf>,
+}
+
+/// `tdex report`.
+#[derive(Debug, clap::Args)]
+pub struct ReportArgs {
+    /// The recording, made with --reference K.
+    pub recording: PathBuf,
+    /// The extrapolation of that recording.
+    pub extrapolation: PathBuf,
+    /// The report directory (created if missing; files in it are replaced).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// A further DEM run of the same case over the same t_k, added to the recording's
+    /// own twins to measure the DEM's run-to-run spread (as `compare --dem-run`).
+    #[arg(long = "dem-run", value_name = "RECORDING")]
+    pub dem_runs: Vec<PathBuf>,
+    /// Voronoi cells (seeds drawn inside the bed).
+    #[arg(long, default_value_t = crate::compare::DEFAULT_CELLS, value_parser = cells())]
+    pub cells: usize,
+    /// Seed of the cell centres.
+    #[arg(long, default_value_t = crate::compare::DEFAULT_SEED)]
+    pub seed: u64,
+}
+
+/// `tdex demo`.
+#[derive(Debug, clap::Args)]
+pub struct DemoArgs {
+    /// Directory for the case, the recording, the extrapolation and the report.
+    #[arg(short = 'o', long = "output", default_value = "tdex-demo")]
+    pub output: PathBuf,
+    /// Worker threads (default: all cores). Results do not depend on it.
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+}
+
+/// `tdex inspect`.
+#[derive(Debug, clap::Args)]
+pub struct InspectArgs {
+    /// The recording or extrapolation (MCAP).
+    pub file: PathBuf,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `tdex bench CASE [...]` or `tdex bench record CASE [...]`.
@@ -257,25 +289,29 @@ pub struct BenchArgs {
 pub enum BenchCommand {
     /// Recording overhead: from one state at t0, time the period plain and recorded; report
     /// the ratio and the bytes per row of the table.
-    Record {
-        /// The case file (TOML).
-        case: PathBuf,
-        #[command(flatten)]
-        recording: RecordingFlags,
-        /// Plain/recorded pairs to run (the fastest of each is reported).
-        #[arg(
-            long,
-            default_value_t = 1,
-            value_parser = count::<u32>(1, "a whole number", "give at least 1")
-        )]
-        repeats: u32,
-        /// Worker threads (default: all cores).
-        #[arg(long, value_parser = threads())]
-        threads: Option<usize>,
-        /// Print the result as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Record(BenchRecordArgs),
+}
+
+/// `tdex bench record CASE [...]`.
+#[derive(Debug, clap::Args)]
+pub struct BenchRecordArgs {
+    /// The case file (TOML).
+    pub case: PathBuf,
+    #[command(flatten)]
+    pub recording: RecordingFlags,
+    /// Plain/recorded pairs to run (the fastest of each is reported).
+    #[arg(
+        long,
+        default_value_t = 1,
+        value_parser = count::<u32>(1, "a whole number", "give at least 1")
+    )]
+    pub repeats: u32,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_parser = threads())]
+    pub threads: Option<usize>,
+    /// Print the result as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// How a recording's table is sampled, over which period τ and at which precision: shared by
@@ -327,43 +363,51 @@ pub enum ImportCommand {
     /// vz radius f_Temp`) at t0, t1 = t0 + τ and every later t_k, and the contacts
     /// (`compute pair/gran/local id contactArea` through `dump local`) every n steps of the
     /// period; the same table and snapshots as `tdex record` (docs/liggghts.md).
-    Liggghts {
-        /// The atom dump files: a path or a pattern (`*`, `%`, `?` in the file name; quote it),
-        /// plain or gzip, several timesteps and MPI processes merged by timestep.
-        #[arg(long)]
-        atoms: String,
-        /// The contact dump files (`dump local`), as --atoms.
-        #[arg(long)]
-        contacts: String,
-        /// The case file describing the run (time step, materials, conduction, drum).
-        #[arg(long)]
-        case: PathBuf,
-        /// The recording to write (MCAP); written to a temporary file and renamed at the end.
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        #[command(flatten)]
-        recording: RecordingFlags,
-        /// Print the summary as one JSON object on stdout.
-        #[arg(long)]
-        json: bool,
-    },
+    Liggghts(LiggghtsArgs),
+}
+
+/// `tdex import liggghts`.
+#[derive(Debug, clap::Args)]
+pub struct LiggghtsArgs {
+    /// The atom dump files: a path or a pattern (`*`, `%`, `?` in the file name; quote it),
+    /// plain or gzip, several timesteps and MPI processes merged by timestep.
+    #[arg(long)]
+    pub atoms: String,
+    /// The contact dump files (`dump local`), as --atoms.
+    #[arg(long)]
+    pub contacts: String,
+    /// The case file describing the run (time step, materials, conduction, drum).
+    #[arg(long)]
+    pub case: PathBuf,
+    /// The recording to write (MCAP); written to a temporary file and renamed at the end.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    #[command(flatten)]
+    pub recording: RecordingFlags,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, Subcommand)]
 pub enum ExportCommand {
     /// ParaView files: one VTK PolyData file (.vtp) per snapshot with temperature, radius, id
     /// and velocity, and a .pvd time series that opens them all.
-    Vtk {
-        /// A recording or an extrapolation (MCAP).
-        file: PathBuf,
-        /// The directory for the files (created if missing; files of the same name replaced).
-        #[arg(short = 'o', long = "output")]
-        output: PathBuf,
-        /// For an extrapolation: its recording, to add the DEM − extrapolated temperature
-        /// differences at every t_k that has a DEM reference.
-        #[arg(long)]
-        reference: Option<PathBuf>,
-    },
+    Vtk(VtkArgs),
+}
+
+/// `tdex export vtk`.
+#[derive(Debug, clap::Args)]
+pub struct VtkArgs {
+    /// A recording or an extrapolation (MCAP).
+    pub file: PathBuf,
+    /// The directory for the files (created if missing; files of the same name replaced).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// For an extrapolation: its recording, to add the DEM − extrapolated temperature
+    /// differences at every t_k that has a DEM reference.
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
 }
 
 /// Flags shared by the studies.
@@ -390,102 +434,114 @@ pub struct StudyCommon {
 pub enum StudyCommand {
     /// Sampling study (Figure 10): every (n, Δt_c^max) with Δt_c^max a multiple of n, all
     /// sampled from ONE DEM run, each extrapolated K periods against the DEM reference.
-    Sampling {
-        #[command(flatten)]
-        common: StudyCommon,
-        /// Sampling factors n (steps), comma-separated.
-        #[arg(
-            long = "n",
-            value_delimiter = ',',
-            default_value = "1,5,10,20",
-            allow_hyphen_values = true,
-            value_parser = steps()
-        )]
-        n: Vec<u32>,
-        /// Δt_c^max values (steps), comma-separated.
-        #[arg(
-            long = "dtc-max",
-            value_delimiter = ',',
-            default_value = "10,50,100,200",
-            allow_hyphen_values = true,
-            value_parser = steps()
-        )]
-        dtc_max: Vec<u32>,
-        /// Periods extrapolated and simulated by the DEM for reference.
-        #[arg(long, default_value_t = 6, value_parser = periods())]
-        periods: u32,
-        /// Period τ as a fraction of a drum revolution.
-        #[arg(
-            long = "tau-rev",
-            default_value_t = DEFAULT_TAU_REV,
-            allow_negative_numbers = true,
-            value_parser = tau_rev()
-        )]
-        tau_rev: f64,
-    },
+    Sampling(SamplingStudyArgs),
     /// Pairing-period study (Figures 13–15, Table 8): per τ, record and extrapolate over the
     /// same simulated time (R revolutions) against a DEM reference.
-    Period {
-        #[command(flatten)]
-        common: StudyCommon,
-        /// Periods τ as fractions of a revolution, comma-separated.
-        #[arg(
-            long = "tau-rev",
-            value_delimiter = ',',
-            default_value = "0.25,0.5,1",
-            allow_hyphen_values = true,
-            value_parser = positive("give fractions of a revolution > 0")
-        )]
-        tau_rev: Vec<f64>,
-        /// Revolutions covered after t1 by every τ (R / τ_rev periods each).
-        #[arg(
-            long,
-            default_value_t = 3.0,
-            allow_negative_numbers = true,
-            value_parser = positive("give a number of revolutions > 0")
-        )]
-        revolutions: f64,
-        #[command(flatten)]
-        sampling: SamplingFlags,
-    },
+    Period(PeriodStudyArgs),
     /// Flow-regime study (Figures 11–12): per drum rotation period, the Froude number, the
     /// regime (Mellmann 2001), the dynamic angle of repose, the active-layer thickness and
     /// (where particles move relative to the drum) the extrapolation error and speedup.
-    Regimes {
-        #[command(flatten)]
-        common: StudyCommon,
-        /// Drum rotation periods (s per revolution), comma-separated.
-        #[arg(
-            long = "rev-period",
-            value_delimiter = ',',
-            default_value = "15,5,0.1",
-            allow_hyphen_values = true,
-            value_parser = positive("give rotation periods in seconds > 0")
-        )]
-        rev_period: Vec<f64>,
-        /// Periods extrapolated and simulated by the DEM for reference.
-        #[arg(long, default_value_t = 2, value_parser = periods())]
-        periods: u32,
-        /// Period τ as a fraction of a revolution.
-        #[arg(
-            long = "tau-rev",
-            default_value_t = DEFAULT_TAU_REV,
-            allow_negative_numbers = true,
-            value_parser = tau_rev()
-        )]
-        tau_rev: f64,
-        #[command(flatten)]
-        sampling: SamplingFlags,
-        /// No relative motion below this mean speed relative to solid-body rotation, as a
-        /// fraction of the wall speed ωR: extrapolation is then refused.
-        #[arg(
-            long = "min-relative",
-            default_value_t = crate::study::flow::MIN_RELATIVE,
-            allow_negative_numbers = true,
-            value_parser = non_negative("give a fraction of the wall speed ≥ 0")
-        )]
-        min_relative: f64,
-    },
+    Regimes(RegimesStudyArgs),
+}
+
+/// `tdex study sampling`.
+#[derive(Debug, clap::Args)]
+pub struct SamplingStudyArgs {
+    #[command(flatten)]
+    pub common: StudyCommon,
+    /// Sampling factors n (steps), comma-separated.
+    #[arg(
+        long = "n",
+        value_delimiter = ',',
+        default_value = "1,5,10,20",
+        allow_hyphen_values = true,
+        value_parser = steps()
+    )]
+    pub n: Vec<u32>,
+    /// Δt_c^max values (steps), comma-separated.
+    #[arg(
+        long = "dtc-max",
+        value_delimiter = ',',
+        default_value = "10,50,100,200",
+        allow_hyphen_values = true,
+        value_parser = steps()
+    )]
+    pub dtc_max: Vec<u32>,
+    /// Periods extrapolated and simulated by the DEM for reference.
+    #[arg(long, default_value_t = 6, value_parser = periods())]
+    pub periods: u32,
+    /// Period τ as a fraction of a drum revolution.
+    #[arg(
+        long = "tau-rev",
+        default_value_t = DEFAULT_TAU_REV,
+        allow_negative_numbers = true,
+        value_parser = tau_rev()
+    )]
+    pub tau_rev: f64,
+}
+
+/// `tdex study period`.
+#[derive(Debug, clap::Args)]
+pub struct PeriodStudyArgs {
+    #[command(flatten)]
+    pub common: StudyCommon,
+    /// Periods τ as fractions of a revolution, comma-separated.
+    #[arg(
+        long = "tau-rev",
+        value_delimiter = ',',
+        default_value = "0.25,0.5,1",
+        allow_hyphen_values = true,
+        value_parser = positive("give fractions of a revolution > 0")
+    )]
+    pub tau_rev: Vec<f64>,
+    /// Revolutions covered after t1 by every τ (R / τ_rev periods each).
+    #[arg(
+        long,
+        default_value_t = 3.0,
+        allow_negative_numbers = true,
+        value_parser = positive("give a number of revolutions > 0")
+    )]
+    pub revolutions: f64,
+    #[command(flatten)]
+    pub sampling: SamplingFlags,
+}
+
+/// `tdex study regimes`.
+#[derive(Debug, clap::Args)]
+pub struct RegimesStudyArgs {
+    #[command(flatten)]
+    pub common: StudyCommon,
+    /// Drum rotation periods (s per revolution), comma-separated.
+    #[arg(
+        long = "rev-period",
+        value_delimiter = ',',
+        default_value = "15,5,0.1",
+        allow_hyphen_values = true,
+        value_parser = positive("give rotation periods in seconds > 0")
+    )]
+    pub rev_period: Vec<f64>,
+    /// Periods extrapolated and simulated by the DEM for reference.
+    #[arg(long, default_value_t = 2, value_parser = periods())]
+    pub periods: u32,
+    /// Period τ as a fraction of a revolution.
+    #[arg(
+        long = "tau-rev",
+        default_value_t = DEFAULT_TAU_REV,
+        allow_negative_numbers = true,
+        value_parser = tau_rev()
+    )]
+    pub tau_rev: f64,
+    #[command(flatten)]
+    pub sampling: SamplingFlags,
+    /// No relative motion below this mean speed relative to solid-body rotation, as a
+    /// fraction of the wall speed ωR: extrapolation is then refused.
+    #[arg(
+        long = "min-relative",
+        default_value_t = crate::study::flow::MIN_RELATIVE,
+        allow_negative_numbers = true,
+        value_parser = non_negative("give a fraction of the wall speed ≥ 0")
+    )]
+    pub min_relative: f64,
 }
 
 impl Cli {

@@ -2,8 +2,10 @@
 //! each other, the files to read and write — is checked here, before any simulation starts.
 
 use super::args::{
-    BenchArgs, BenchCommand, Cli, Command, ExportCommand, ImportCommand, RecordingFlags,
-    SamplingFlags, StudyCommand,
+    BenchArgs, BenchCommand, BenchRecordArgs, Cli, Command, CompareArgs, DemoArgs, ExportCommand,
+    ExtrapolateArgs, ImportCommand, InspectArgs, LiggghtsArgs, PairArgs, PeriodStudyArgs,
+    RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs, SamplingFlags,
+    SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
 };
 use anyhow::Result;
 use extrapolate::replay::Scheme;
@@ -236,240 +238,240 @@ impl Tau {
 }
 
 impl Plan {
+    /// Checks the parsed flags of the command against the case file and each other, and
+    /// builds its plan.
     pub fn from_args(cli: Cli) -> Result<Self> {
-        match cli.command {
-            Command::Run {
-                case,
-                threads,
-                json,
-            } => {
-                let loaded = recorder::case::load(&case)?;
-                Ok(Plan::Run(RunPlan {
-                    case_path: case,
-                    case: loaded,
-                    threads: workers(threads),
-                    json,
-                }))
+        Ok(match cli.command {
+            Command::Run(args) => Plan::Run(RunPlan::from_args(args)?),
+            Command::Record(args) => Plan::Record(RecordPlan::from_args(args)?),
+            Command::Inspect(InspectArgs { file, json }) => {
+                Plan::Inspect(InspectPlan { file, json })
             }
-            Command::Record {
-                case,
-                output,
-                recording,
-                reference,
-                twins,
-                threads,
-                json,
-                checkpoint_every,
-                resume,
-                reproducible,
-            } => {
-                let start = match (resume, case, output) {
-                    (Some(path), _, _) => {
-                        let checkpoint = recorder::record::Checkpoint::read(&path)?;
-                        let case = checkpoint.case(&path)?;
-                        RecordStart::Resume {
-                            path,
-                            checkpoint: Box::new(checkpoint),
-                            case: Box::new(case),
-                            checkpoint_every,
-                        }
-                    }
-                    (None, Some(case), Some(output)) => {
-                        let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                        let mut options = table_options(&loaded, &recording, reference)?;
-                        check_output(&output)?;
-                        if twins > 0 && reference == 0 {
-                            return Err(usage(format!(
-                                "--twins {twins} needs --reference K: the twins run over the \
-                                 reference periods"
-                            )));
-                        }
-                        options.twins = twins;
-                        RecordStart::Fresh {
-                            case_path: case,
-                            case_toml,
-                            case: Box::new(loaded),
-                            output,
-                            options,
-                            checkpoint_every,
-                            reproducible,
-                        }
-                    }
-                    // clap requires both without --resume
-                    (None, _, _) => {
-                        return Err(usage(
-                            "give the case file and -o OUTPUT to record, or --resume CHECKPOINT"
-                                .into(),
-                        ))
-                    }
-                };
-                Ok(Plan::Record(RecordPlan {
-                    start,
-                    threads: workers(threads),
-                    json,
-                }))
+            Command::Pair(args) => Plan::Pair(PairPlan::from_args(args)),
+            Command::Extrapolate(args) => Plan::Extrapolate(ExtrapolatePlan::from_args(args)?),
+            Command::Compare(args) => Plan::Compare(ComparePlan::from_args(args)),
+            Command::Report(args) => Plan::Report(ReportPlan::from_args(args)?),
+            Command::Demo(args) => Plan::Demo(DemoPlan::from_args(args)?),
+            Command::Study(study) => Plan::Study(StudyPlan::from_args(study)?),
+            Command::Import(ImportCommand::Liggghts(args)) => {
+                Plan::ImportLiggghts(ImportPlan::from_args(args)?)
             }
-            Command::Inspect { file, json } => Ok(Plan::Inspect(InspectPlan { file, json })),
-            Command::Pair {
-                file,
-                threads,
-                reproducible,
-                json,
-            } => Ok(Plan::Pair(PairPlan {
-                file,
-                threads: workers(threads),
-                reproducible,
-                json,
-            })),
-            Command::Extrapolate {
-                file,
-                periods,
-                output,
-                scheme,
-                stream,
-                max_memory,
-                threads,
-                reproducible,
-                json,
-            } => {
-                check_output(&output)?;
-                Ok(Plan::Extrapolate(ExtrapolatePlan {
-                    file,
-                    periods,
-                    output,
-                    scheme,
-                    stream,
-                    max_memory,
-                    threads: workers(threads),
-                    reproducible,
-                    json,
-                }))
+            Command::Export(ExportCommand::Vtk(args)) => {
+                Plan::ExportVtk(ExportVtkPlan::from_args(args)?)
             }
-            Command::Compare {
-                recording,
-                extrapolation,
-                cells,
-                seed,
-                json,
-                csv,
-                dem_runs,
-            } => Ok(Plan::Compare(ComparePlan {
-                recording,
-                extrapolation,
-                dem_runs,
-                cells,
-                seed,
-                json,
-                csv,
-            })),
-            Command::Report {
-                recording,
-                extrapolation,
-                output,
-                dem_runs,
-                cells,
-                seed,
-            } => {
-                check_output_dir(&output)?;
-                Ok(Plan::Report(ReportPlan {
-                    recording,
-                    extrapolation,
-                    output,
-                    dem_runs,
-                    cells,
-                    seed,
-                }))
-            }
-            Command::Demo { output, threads } => {
-                check_output_dir(&output)?;
-                Ok(Plan::Demo(DemoPlan {
-                    output,
-                    threads: workers(threads),
-                }))
-            }
-            Command::Study(study) => Ok(Plan::Study(study_plan(study)?)),
-            Command::Import(ImportCommand::Liggghts {
-                atoms,
-                contacts,
-                case,
-                output,
-                recording,
-                json,
-            }) => {
-                let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = table_options(&loaded, &recording, 0)?;
-                check_output(&output)?;
-                Ok(Plan::ImportLiggghts(ImportPlan {
-                    dumps: recorder::import::liggghts::Dumps { atoms, contacts },
-                    case_path: case,
-                    case_toml,
-                    case: loaded,
-                    output,
-                    options,
-                    json,
-                }))
-            }
-            Command::Export(ExportCommand::Vtk {
-                file,
-                output,
-                reference,
-            }) => {
-                check_output_dir(&output)?;
-                Ok(Plan::ExportVtk(ExportVtkPlan {
-                    file,
-                    output,
-                    reference,
-                }))
-            }
-            Command::Bench(BenchArgs {
-                command: None,
-                case: Some(case),
-                steps,
-                threads,
-                vs_liggghts,
-                liggghts_dir,
-                json,
-            }) => {
-                let loaded = recorder::case::load(&case)?;
-                if let Some(dir) = &liggghts_dir {
-                    check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
+            Command::Bench(args) => match args.command {
+                Some(BenchCommand::Record(record)) => {
+                    Plan::BenchRecord(BenchRecordPlan::from_args(record)?)
                 }
-                Ok(Plan::Bench(BenchPlan {
-                    case_path: case,
-                    case: loaded,
-                    steps,
-                    threads: workers(threads),
-                    liggghts: vs_liggghts.then_some(liggghts_dir),
-                    json,
-                }))
-            }
-            Command::Bench(BenchArgs { command: None, case: None, .. }) => Err(usage(
-                "tdex bench needs a case file (tdex bench CASE) or a subcommand (tdex bench record CASE)".into(),
-            )),
-            Command::Bench(BenchArgs {
-                command:
-                    Some(BenchCommand::Record {
-                        case,
-                        recording,
-                        repeats,
-                        threads,
-                        json,
-                    }),
-                ..
-            }) => {
+                None => Plan::Bench(BenchPlan::from_args(args)?),
+            },
+        })
+    }
+}
+
+impl RunPlan {
+    fn from_args(args: RunArgs) -> Result<Self> {
+        let case = recorder::case::load(&args.case)?;
+        Ok(RunPlan {
+            case_path: args.case,
+            case,
+            threads: workers(args.threads),
+            json: args.json,
+        })
+    }
+}
+
+impl RecordPlan {
+    fn from_args(args: RecordArgs) -> Result<Self> {
+        let (threads, json) = (args.threads, args.json);
+        let start = RecordStart::from_args(args)?;
+        Ok(RecordPlan {
+            start,
+            threads: workers(threads),
+            json,
+        })
+    }
+}
+
+impl RecordStart {
+    fn from_args(args: RecordArgs) -> Result<Self> {
+        match (args.resume, args.case, args.output) {
+            (Some(path), _, _) => RecordStart::resume(path, args.checkpoint_every),
+            (None, Some(case), Some(output)) => {
                 let (loaded, case_toml) = recorder::case::load_with_text(&case)?;
-                let options = table_options(&loaded, &recording, 0)?;
-                Ok(Plan::BenchRecord(BenchRecordPlan {
+                let mut options = table_options(&loaded, &args.recording, args.reference)?;
+                check_output(&output)?;
+                let (twins, reference) = (args.twins, args.reference);
+                if twins > 0 && reference == 0 {
+                    return Err(usage(format!(
+                        "--twins {twins} needs --reference K: the twins run over the \
+                         reference periods"
+                    )));
+                }
+                options.twins = twins;
+                Ok(RecordStart::Fresh {
                     case_path: case,
                     case_toml,
-                    case: loaded,
+                    case: Box::new(loaded),
+                    output,
                     options,
-                    repeats,
-                    threads: workers(threads),
-                    json,
-                }))
+                    checkpoint_every: args.checkpoint_every,
+                    reproducible: args.reproducible,
+                })
             }
+            // clap requires both without --resume
+            (None, _, _) => Err(usage(
+                "give the case file and -o OUTPUT to record, or --resume CHECKPOINT".into(),
+            )),
         }
+    }
+
+    /// The rest of the run checkpointed in `path`, its case checked again.
+    fn resume(path: PathBuf, checkpoint_every: Option<f64>) -> Result<Self> {
+        let checkpoint = recorder::record::Checkpoint::read(&path)?;
+        let case = checkpoint.case(&path)?;
+        Ok(RecordStart::Resume {
+            path,
+            checkpoint: Box::new(checkpoint),
+            case: Box::new(case),
+            checkpoint_every,
+        })
+    }
+}
+
+impl PairPlan {
+    fn from_args(args: PairArgs) -> Self {
+        PairPlan {
+            file: args.file,
+            threads: workers(args.threads),
+            reproducible: args.reproducible,
+            json: args.json,
+        }
+    }
+}
+
+impl ExtrapolatePlan {
+    fn from_args(args: ExtrapolateArgs) -> Result<Self> {
+        check_output(&args.output)?;
+        Ok(ExtrapolatePlan {
+            file: args.file,
+            periods: args.periods,
+            output: args.output,
+            scheme: args.scheme,
+            stream: args.stream,
+            max_memory: args.max_memory,
+            threads: workers(args.threads),
+            reproducible: args.reproducible,
+            json: args.json,
+        })
+    }
+}
+
+impl ComparePlan {
+    fn from_args(args: CompareArgs) -> Self {
+        ComparePlan {
+            recording: args.recording,
+            extrapolation: args.extrapolation,
+            dem_runs: args.dem_runs,
+            cells: args.cells,
+            seed: args.seed,
+            json: args.json,
+            csv: args.csv,
+        }
+    }
+}
+
+impl ReportPlan {
+    fn from_args(args: ReportArgs) -> Result<Self> {
+        check_output_dir(&args.output)?;
+        Ok(ReportPlan {
+            recording: args.recording,
+            extrapolation: args.extrapolation,
+            output: args.output,
+            dem_runs: args.dem_runs,
+            cells: args.cells,
+            seed: args.seed,
+        })
+    }
+}
+
+impl DemoPlan {
+    fn from_args(args: DemoArgs) -> Result<Self> {
+        check_output_dir(&args.output)?;
+        Ok(DemoPlan {
+            output: args.output,
+            threads: workers(args.threads),
+        })
+    }
+}
+
+impl ImportPlan {
+    fn from_args(args: LiggghtsArgs) -> Result<Self> {
+        let (case, case_toml) = recorder::case::load_with_text(&args.case)?;
+        let options = table_options(&case, &args.recording, 0)?;
+        check_output(&args.output)?;
+        Ok(ImportPlan {
+            dumps: recorder::import::liggghts::Dumps {
+                atoms: args.atoms,
+                contacts: args.contacts,
+            },
+            case_path: args.case,
+            case_toml,
+            case,
+            output: args.output,
+            options,
+            json: args.json,
+        })
+    }
+}
+
+impl ExportVtkPlan {
+    fn from_args(args: VtkArgs) -> Result<Self> {
+        check_output_dir(&args.output)?;
+        Ok(ExportVtkPlan {
+            file: args.file,
+            output: args.output,
+            reference: args.reference,
+        })
+    }
+}
+
+impl BenchPlan {
+    /// `tdex bench CASE`: the arguments without a subcommand.
+    fn from_args(args: BenchArgs) -> Result<Self> {
+        let Some(case_path) = args.case else {
+            return Err(usage(
+                "tdex bench needs a case file (tdex bench CASE) or a subcommand (tdex bench record CASE)".into(),
+            ));
+        };
+        let case = recorder::case::load(&case_path)?;
+        if let Some(dir) = &args.liggghts_dir {
+            check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
+        }
+        Ok(BenchPlan {
+            case_path,
+            case,
+            steps: args.steps,
+            threads: workers(args.threads),
+            liggghts: args.vs_liggghts.then_some(args.liggghts_dir),
+            json: args.json,
+        })
+    }
+}
+
+impl BenchRecordPlan {
+    fn from_args(args: BenchRecordArgs) -> Result<Self> {
+        let (case, case_toml) = recorder::case::load_with_text(&args.case)?;
+        let options = table_options(&case, &args.recording, 0)?;
+        Ok(BenchRecordPlan {
+            case_path: args.case,
+            case_toml,
+            case,
+            options,
+            repeats: args.repeats,
+            threads: workers(args.threads),
+            json: args.json,
+        })
     }
 }
 
@@ -611,141 +613,174 @@ fn with_rotation_period(text: &str, period: f64) -> Option<String> {
     Some(doc.to_string())
 }
 
-fn study_plan(study: StudyCommand) -> Result<StudyPlan> {
-    let (common, kind_name) = match &study {
-        StudyCommand::Sampling { common, .. } => (common.clone(), "sampling"),
-        StudyCommand::Period { common, .. } => (common.clone(), "period"),
-        StudyCommand::Regimes { common, .. } => (common.clone(), "regimes"),
-    };
-    let output = common
-        .output
-        .clone()
-        .unwrap_or_else(|| PathBuf::from(format!("tdex-study-{kind_name}")));
-    check_output_dir(&output)?;
-    let (case, case_toml) = recorder::case::load_with_text(&common.case)?;
-    let kind = match study {
-        StudyCommand::Sampling {
+impl StudyCommand {
+    /// The flags every study takes.
+    fn common(&self) -> &StudyCommon {
+        match self {
+            StudyCommand::Sampling(args) => &args.common,
+            StudyCommand::Period(args) => &args.common,
+            StudyCommand::Regimes(args) => &args.common,
+        }
+    }
+
+    /// The study's name, as on the command line.
+    fn name(&self) -> &'static str {
+        match self {
+            StudyCommand::Sampling(_) => "sampling",
+            StudyCommand::Period(_) => "period",
+            StudyCommand::Regimes(_) => "regimes",
+        }
+    }
+}
+
+impl StudyPlan {
+    fn from_args(study: StudyCommand) -> Result<Self> {
+        let common = study.common().clone();
+        let output = common
+            .output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("tdex-study-{}", study.name())));
+        check_output_dir(&output)?;
+        let (case, case_toml) = recorder::case::load_with_text(&common.case)?;
+        let kind = match study {
+            StudyCommand::Sampling(args) => StudyKind::sampling(args, &case)?,
+            StudyCommand::Period(args) => StudyKind::period(args, &case)?,
+            StudyCommand::Regimes(args) => StudyKind::regimes(args, &case_toml)?,
+        };
+        Ok(StudyPlan {
+            case_path: common.case,
+            case_toml,
+            case,
+            output,
+            cells: common.cells,
+            threads: workers(common.threads),
+            json: common.json,
+            kind,
+        })
+    }
+}
+
+impl StudyKind {
+    /// Every `(n, Δt_c^max)` of the lists with Δt_c^max a multiple of n, checked against the
+    /// case; the others are skipped.
+    fn sampling(args: SamplingStudyArgs, case: &Case) -> Result<Self> {
+        let SamplingStudyArgs {
             n,
             dtc_max,
             periods,
             tau_rev,
             ..
-        } => {
-            let (ns, dtcs) = (distinct(n), distinct(dtc_max));
-            let mut runs = Vec::new();
-            let mut skipped = Vec::new();
-            for &n in &ns {
-                for &dtc_max in &dtcs {
-                    if !dtc_max.is_multiple_of(n) {
-                        skipped.push((n, dtc_max));
-                        continue;
-                    }
-                    runs.push(record_options(
-                        &case,
-                        Tau::Revolutions(tau_rev),
-                        SamplingFlags { n, dtc_max },
-                        periods,
-                        AreaEncoding::Quantized,
-                    )?);
+        } = args;
+        let (ns, dtcs) = (distinct(n), distinct(dtc_max));
+        let mut runs = Vec::new();
+        let mut skipped = Vec::new();
+        for &n in &ns {
+            for &dtc_max in &dtcs {
+                if !dtc_max.is_multiple_of(n) {
+                    skipped.push((n, dtc_max));
+                    continue;
                 }
-            }
-            if runs.is_empty() {
-                return Err(usage(format!(
-                    "--n {} --dtc-max {}: no Δt_c^max is a multiple of any n, so there is nothing to run",
-                    comma_separated(&ns),
-                    comma_separated(&dtcs)
-                )));
-            }
-            StudyKind::Sampling {
-                runs,
-                skipped,
-                tau_rev,
+                runs.push(record_options(
+                    case,
+                    Tau::Revolutions(tau_rev),
+                    SamplingFlags { n, dtc_max },
+                    periods,
+                    AreaEncoding::Quantized,
+                )?);
             }
         }
-        StudyCommand::Period {
+        if runs.is_empty() {
+            return Err(usage(format!(
+                "--n {} --dtc-max {}: no Δt_c^max is a multiple of any n, so there is nothing to run",
+                comma_separated(&ns),
+                comma_separated(&dtcs)
+            )));
+        }
+        Ok(StudyKind::Sampling {
+            runs,
+            skipped,
+            tau_rev,
+        })
+    }
+
+    /// One recording per τ, over a whole number of periods covering the same revolutions.
+    fn period(args: PeriodStudyArgs, case: &Case) -> Result<Self> {
+        let PeriodStudyArgs {
             tau_rev,
             revolutions,
             sampling,
             ..
-        } => {
-            let mut runs = Vec::new();
-            for f in distinct(tau_rev) {
-                let k = revolutions / f;
-                let periods = k.round();
-                if periods < 1.0 || (k - periods).abs() > 1e-9 * k {
-                    return Err(usage(format!(
-                        "--tau-rev {f} with --revolutions {revolutions}: {revolutions} revolutions are {} periods of {f} revolution; they must be a whole number ≥ 1",
-                        crate::fmt::sig(k, 9)
-                    )));
-                }
-                runs.push((
-                    f,
-                    record_options(
-                        &case,
-                        Tau::Revolutions(f),
-                        sampling,
-                        periods as u32,
-                        AreaEncoding::Quantized,
-                    )?,
-                ));
+        } = args;
+        let mut runs = Vec::new();
+        for f in distinct(tau_rev) {
+            let k = revolutions / f;
+            let periods = k.round();
+            if periods < 1.0 || (k - periods).abs() > 1e-9 * k {
+                return Err(usage(format!(
+                    "--tau-rev {f} with --revolutions {revolutions}: {revolutions} revolutions are {} periods of {f} revolution; they must be a whole number ≥ 1",
+                    crate::fmt::sig(k, 9)
+                )));
             }
-            StudyKind::Period { runs, revolutions }
+            runs.push((
+                f,
+                record_options(
+                    case,
+                    Tau::Revolutions(f),
+                    sampling,
+                    periods as u32,
+                    AreaEncoding::Quantized,
+                )?,
+            ));
         }
-        StudyCommand::Regimes {
+        Ok(StudyKind::Period { runs, revolutions })
+    }
+
+    /// One case per drum rotation period, made from the case text `case_toml`.
+    fn regimes(args: RegimesStudyArgs, case_toml: &str) -> Result<Self> {
+        let RegimesStudyArgs {
+            common,
             rev_period,
             periods,
             tau_rev,
             sampling,
             min_relative,
-            ..
-        } => {
-            let mut runs = Vec::new();
-            for t in distinct(rev_period) {
-                let text = with_rotation_period(&case_toml, t).ok_or_else(|| {
-                    usage(format!(
-                        "{}: no `rotation_period = ...` line in its [drum] table to vary",
-                        common.case.display()
-                    ))
-                })?;
-                let case_t = recorder::case::parse(&text, &common.case)?;
-                // no DEM reference where the extrapolation is refused anyway (Fr ≥ 1)
-                let reference = if crate::study::flow::froude(&case_t) >= 1.0 {
-                    0
-                } else {
-                    periods
-                };
-                let options = record_options(
-                    &case_t,
-                    Tau::Revolutions(tau_rev),
-                    sampling,
-                    reference,
-                    AreaEncoding::Quantized,
-                )
-                .map_err(|e| usage(format!("--rev-period {t}: {e}")))?;
-                runs.push(RegimeRun {
-                    rotation_period: t,
-                    case: case_t,
-                    case_toml: text,
-                    options,
-                });
-            }
-            StudyKind::Regimes {
-                runs,
-                tau_rev,
-                min_relative,
-            }
+        } = args;
+        let mut runs = Vec::new();
+        for t in distinct(rev_period) {
+            let text = with_rotation_period(case_toml, t).ok_or_else(|| {
+                usage(format!(
+                    "{}: no `rotation_period = ...` line in its [drum] table to vary",
+                    common.case.display()
+                ))
+            })?;
+            let case_t = recorder::case::parse(&text, &common.case)?;
+            // no DEM reference where the extrapolation is refused anyway (Fr ≥ 1)
+            let reference = if crate::study::flow::froude(&case_t) >= 1.0 {
+                0
+            } else {
+                periods
+            };
+            let options = record_options(
+                &case_t,
+                Tau::Revolutions(tau_rev),
+                sampling,
+                reference,
+                AreaEncoding::Quantized,
+            )
+            .map_err(|e| usage(format!("--rev-period {t}: {e}")))?;
+            runs.push(RegimeRun {
+                rotation_period: t,
+                case: case_t,
+                case_toml: text,
+                options,
+            });
         }
-    };
-    Ok(StudyPlan {
-        case_path: common.case,
-        case_toml,
-        case,
-        output,
-        cells: common.cells,
-        threads: workers(common.threads),
-        json: common.json,
-        kind,
-    })
+        Ok(StudyKind::Regimes {
+            runs,
+            tau_rev,
+            min_relative,
+        })
+    }
 }
 
 /// Values as a comma-separated list, as the flag takes them.

@@ -5,4 +5,5 @@ mod cell_grid;
 mod verlet_list;
 
 pub use cell_grid::CellGrid;
+pub(crate) use verlet_list::ListPieces;
 pub use verlet_list::NeighborList;

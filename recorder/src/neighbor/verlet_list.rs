@@ -10,7 +10,7 @@ use crate::contact::contact_sphere_sphere::{effective, overlapping};
 use crate::contact::ContactHistory;
 use crate::math::*;
 use crate::particles::{ParticleSet, PermuteScratch};
-use crate::slices::for_each_task;
+use crate::slices::{for_each_task, pieces_at, slices_indexed_alike};
 use crate::wall::WallSet;
 use rayon::prelude::*;
 
@@ -236,24 +236,39 @@ impl NeighborList {
             (&self.offsets, &self.wall_offsets, &self.layer_start);
         let start = |l: usize| {
             let first = layer_start[l] as usize;
-            let (e, w) = (offsets[first] as usize, wall_offsets[first] as usize);
-            (e, (e, (e, (w, (w, w)))))
+            ListStart {
+                pair_entry: offsets[first] as usize,
+                wall_candidate: wall_offsets[first] as usize,
+            }
         };
         let (ids, carried) = (&particles.id, &self.carried);
-        let arrays = (
-            &mut self.neighbors[..],
-            (
-                &mut self.history[..],
-                (
-                    &mut self.touching[..],
-                    (
-                        &mut self.wall_index[..],
-                        (&mut self.wall_history[..], &mut self.wall_touching[..]),
-                    ),
-                ),
-            ),
-        );
-        let fill = |l: usize, (partner, (history, (touch, (wall, (wall_history, wall_touch))))): ListPieces| {
+        let arrays = FillPieces {
+            partners: &mut self.neighbors[..],
+            pairs: ListPieces {
+                histories: &mut self.history[..],
+                touching: &mut self.touching[..],
+            },
+            wall_index: &mut self.wall_index[..],
+            walls: ListPieces {
+                histories: &mut self.wall_history[..],
+                touching: &mut self.wall_touching[..],
+            },
+        };
+        let fill = |l: usize, pieces: FillPieces| {
+            let FillPieces {
+                partners: partner,
+                pairs:
+                    ListPieces {
+                        histories: history,
+                        touching: touch,
+                    },
+                wall_index: wall,
+                walls:
+                    ListPieces {
+                        histories: wall_history,
+                        touching: wall_touch,
+                    },
+            } = pieces;
             let (mut e, mut w, mut packed) = (0, 0, 0);
             for i in layer_start[l] as usize..layer_start[l + 1] as usize {
                 search.partners(i, |j, now_touching| {
@@ -278,8 +293,13 @@ impl NeighborList {
             }
             0
         };
-        let origin = (0, (0, (0, (0, (0, 0)))));
-        for_each_task(arrays, origin, 0..grid.layers(), &start, &fill);
+        for_each_task(
+            arrays,
+            ListStart::default(),
+            0..grid.layers(),
+            &start,
+            &fill,
+        );
 
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
@@ -399,18 +419,42 @@ impl NeighborList {
     }
 }
 
-/// One list-filling task's pieces: partners, histories, touching flags, and the same for
-/// its wall candidates.
-type ListPieces<'a> = (
-    &'a mut [u32],
-    (
-        &'a mut [ContactHistory],
-        (
-            &'a mut [bool],
-            (&'a mut [u8], (&'a mut [ContactHistory], &'a mut [bool])),
-        ),
-    ),
-);
+/// Histories and touching flags of a task's list entries (pair entries or wall candidates),
+/// from where its pieces start.
+pub(crate) struct ListPieces<'a> {
+    pub(crate) histories: &'a mut [ContactHistory],
+    pub(crate) touching: &'a mut [bool],
+}
+
+slices_indexed_alike!(ListPieces {
+    histories,
+    touching
+});
+
+/// One list-filling task's pieces: the partner slots, histories and touching flags of its
+/// pair entries, and the wall, histories and touching flags of its wall candidates.
+struct FillPieces<'a> {
+    partners: &'a mut [u32],
+    pairs: ListPieces<'a>,
+    wall_index: &'a mut [u8],
+    walls: ListPieces<'a>,
+}
+
+/// Where a list-filling task's pieces start in each kind of array.
+#[derive(Debug, Clone, Copy, Default)]
+struct ListStart {
+    /// In the pair entries.
+    pair_entry: usize,
+    /// In the wall candidates.
+    wall_candidate: usize,
+}
+
+pieces_at!(FillPieces at ListStart {
+    partners: pair_entry,
+    pairs: pair_entry,
+    wall_index: wall_candidate,
+    walls: wall_candidate
+});
 
 /// The broad-phase search over particles already in cell order.
 struct Search<'a> {
