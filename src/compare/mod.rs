@@ -236,17 +236,13 @@ pub fn compare(
     cells: usize,
     seed: u64,
 ) -> Result<Comparison> {
-    compare_with(recording, Second::Extrapolation(extrapolation), cells, seed)
-}
-
-/// Compares the `second` field with the DEM reference snapshots of `recording`.
-pub fn compare_with(
-    recording: &RecordingReader,
-    second: Second,
-    cells: usize,
-    seed: u64,
-) -> Result<Comparison> {
-    compare_runs(recording, second, &[], cells, seed)
+    compare_runs(
+        recording,
+        Second::Extrapolation(extrapolation),
+        &[],
+        cells,
+        seed,
+    )
 }
 
 /// Compares the `second` field with the DEM reference snapshots of `recording`, and measures

@@ -129,16 +129,6 @@ impl Scheme {
     }
 }
 
-impl std::str::FromStr for Scheme {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Scheme::ALL
-            .into_iter()
-            .find(|scheme| scheme.name() == s)
-            .ok_or_else(|| format!("unknown scheme '{s}': use explicit, exact or synchronous"))
-    }
-}
-
 /// A wall that can appear in the table as body `particles + index`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct WallInfo {
