@@ -118,6 +118,7 @@ mod tests {
             seconds_reference: 0.0,
             seconds_recorder: 7619.0,
             seconds_twins: 0.0,
+            seconds_each_period: Vec::new(),
             stage_seconds: Default::default(),
             threads: 1,
         };

@@ -43,6 +43,8 @@ pub fn twin_topic(twin: u32) -> String {
 }
 /// Most DEM twins a recording may hold (each costs the reference periods again).
 pub const MAX_TWINS: u32 = 16;
+/// Most consecutive periods one recording may hold (`--recorded-periods P`).
+pub const MAX_RECORDED_PERIODS: u32 = 64;
 /// Channel of the collision table (`tdex.CollisionBatch`).
 pub const COLLISION_TOPIC: &str = "/tdex/collisions";
 /// Metadata record written first: [`RecordingInfo`] as JSON under the key `json`.
@@ -171,6 +173,13 @@ pub struct RecordingInfo {
     /// without twins is the same bytes as before twins existed.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub twins: u32,
+    /// Consecutive periods recorded (`--recorded-periods P`): `P` collision tables one
+    /// after the other in the table (period `p`, 0-based, holds the rows that start in
+    /// `[p τ, (p+1) τ)` steps from `t0`, cut at the period boundaries; no batch spans two
+    /// periods) and the snapshots `t0 … tP`. Absent from the JSON when 1 (the paper's
+    /// method), so that such a recording is the same bytes as before the field existed.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub recorded_periods: u32,
     pub area_encoding: AreaEncoding,
     /// Metres per `sqrt(a)` code (quantised encoding), else 0.
     pub sqrt_area_unit: f64,
@@ -189,6 +198,18 @@ impl RecordingInfo {
     pub fn snapshot_time(&self, index: u32) -> f64 {
         // in f64 (exact below 2^53 steps): a damaged file's step counts cannot overflow
         (self.step_t0 as f64 + index as f64 * self.period_steps as f64) * self.dt
+    }
+
+    /// Index of the last snapshot of the run: `tP` or the last reference `t_{K+1}`, whichever
+    /// is later (the reference snapshots inside the recorded stretch are its own snapshots).
+    pub fn last_snapshot(&self) -> u32 {
+        self.recorded_periods
+            .max(self.reference_periods.saturating_add(1))
+    }
+
+    /// The recorded period (0-based) a row starting `start_step` steps after `t0` belongs to.
+    pub fn period_of_step(&self, start_step: u64) -> u64 {
+        start_step / self.period_steps.max(1)
     }
 
     /// Checks the values the readers and the replay rely on; the error names the field, its
@@ -235,6 +256,13 @@ impl RecordingInfo {
                 ),
             );
         }
+        if !(1..=MAX_RECORDED_PERIODS).contains(&self.recorded_periods) {
+            return bad(
+                "recorded_periods",
+                &self.recorded_periods,
+                &format!("must be between 1 and {MAX_RECORDED_PERIODS}"),
+            );
+        }
         for (field, value) in [
             ("sample_every", self.sample_every as u64),
             ("dtc_max_steps", self.dtc_max_steps as u64),
@@ -244,7 +272,7 @@ impl RecordingInfo {
                 return bad(field, &value, "must be at least 1");
             }
         }
-        let last_step = (self.reference_periods as u64 + 1)
+        let last_step = (self.last_snapshot() as u64)
             .checked_mul(self.period_steps)
             .and_then(|s| s.checked_add(self.step_t0));
         if last_step.is_none() {
@@ -252,8 +280,9 @@ impl RecordingInfo {
                 "step_t0",
                 &self.step_t0,
                 &format!(
-                    "with {} reference periods of {} steps, must end before step 2^64",
-                    self.reference_periods, self.period_steps
+                    "with {} snapshots after t0, {} steps apart, must end before step 2^64",
+                    self.last_snapshot(),
+                    self.period_steps
                 ),
             );
         }
@@ -290,6 +319,14 @@ fn is_zero(x: &u32) -> bool {
     *x == 0
 }
 
+fn one() -> u32 {
+    1
+}
+
+fn is_one(x: &u32) -> bool {
+    *x == 1
+}
+
 fn is_zero_f64(x: &f64) -> bool {
     *x == 0.0
 }
@@ -305,8 +342,12 @@ pub struct RecordingSummary {
     /// at `s` consecutive samples, i.e. lasting between `(s−1)n+1` and `(s+1)n−1` steps.
     /// Collisions open at `t0` or `t1` count with their length inside the period.
     pub duration_histogram: Vec<u64>,
-    /// Snapshots stored (`t0`, `t1`, then one per reference period).
+    /// Snapshots stored (`t0`, `t1`, then one per further recorded or reference period).
     pub snapshots: u32,
+    /// Rows of each recorded period, when there are several (absent for one: the paper's
+    /// method, whose summary is the same bytes as before).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub period_rows: Vec<u64>,
 }
 
 /// What the run cost, for the speedup report; the last metadata record.
@@ -321,6 +362,10 @@ pub struct RecordingCosts {
     /// The DEM twins' reference periods, all twins (absent without twins).
     #[serde(default, skip_serializing_if = "is_zero_f64")]
     pub seconds_twins: f64,
+    /// Wall-clock seconds of each recorded period, DEM and recorder, when there are several
+    /// (their sum is `seconds_period`): what recording `p < P` periods would have cost.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub seconds_each_period: Vec<f64>,
     /// Per-stage DEM seconds over the whole run.
     pub stage_seconds: BTreeMap<String, f64>,
     pub threads: usize,

@@ -207,6 +207,39 @@ impl RecordingReader {
         Ok(None)
     }
 
+    /// The rows of recorded period `period` (0-based), batch by batch in apparition order,
+    /// start steps still counted from `t0`. The batches of the other periods are decoded and
+    /// skipped (a batch never spans two periods).
+    pub fn period_table(
+        &self,
+        period: u32,
+    ) -> impl Iterator<Item = Result<TableBatch, FormatError>> + '_ {
+        let period = period as u64;
+        self.table().filter_map(move |batch| {
+            let batch = match batch {
+                Ok(batch) => batch,
+                Err(e) => return Some(Err(e)),
+            };
+            let of = |r: &CollisionRow| self.info.period_of_step(r.start_step);
+            let (first, last) = (batch.rows.first()?, batch.rows.last()?);
+            if of(first) != of(last) {
+                return Some(Err(self.corrupt(format!(
+                    "batch at row {} spans recorded periods {} to {} (a batch holds one period's rows)",
+                    batch.first_row,
+                    of(first),
+                    of(last)
+                ))));
+            }
+            if of(first) >= self.info.recorded_periods as u64 {
+                return Some(Err(self.corrupt(format!(
+                    "row {}: start step {} is past the {} recorded period(s) of {} steps",
+                    batch.first_row, first.start_step, self.info.recorded_periods, self.info.period_steps
+                ))));
+            }
+            (of(first) == period).then_some(Ok(batch))
+        })
+    }
+
     /// The table, batch by batch in apparition order; memory holds one chunk and one batch.
     pub fn table(&self) -> impl Iterator<Item = Result<TableBatch, FormatError>> + '_ {
         let mut next_row = 0u64;

@@ -25,6 +25,8 @@ pub struct RecordingWriter {
     batches: u64,
     wall_rows: u64,
     snapshots: u32,
+    /// Rows of each recorded period so far (period of the last row pushed last).
+    period_rows: Vec<u64>,
 }
 
 impl RecordingWriter {
@@ -82,6 +84,7 @@ impl RecordingWriter {
             batches: 0,
             wall_rows: 0,
             snapshots: 0,
+            period_rows: Vec::new(),
         })
     }
 
@@ -124,12 +127,22 @@ impl RecordingWriter {
         result.map_err(|e| self.mcap_err(e))
     }
 
-    /// Appends rows (in apparition order); full batches are encoded and written at once.
+    /// Appends rows (in apparition order); full batches are encoded and written at once. A
+    /// row of a later recorded period than the pending ones first writes them as a batch of
+    /// their own: no batch spans two periods, so a reader takes a period's rows batch by batch.
     pub fn push_rows(
         &mut self,
         rows: impl IntoIterator<Item = CollisionRow>,
     ) -> Result<(), FormatError> {
         for row in rows {
+            let period = self.info.period_of_step(row.start_step) as usize;
+            if period + 1 != self.period_rows.len() {
+                self.write_batch()?;
+                if self.period_rows.len() <= period {
+                    self.period_rows.resize(period + 1, 0);
+                }
+            }
+            self.period_rows[period] += 1;
             self.wall_rows += (row.j >= self.info.particles) as u64;
             self.pending.push(row);
             if self.pending.len() == BATCH_ROWS {
@@ -185,6 +198,13 @@ impl RecordingWriter {
             batches: self.batches,
             duration_histogram,
             snapshots: self.snapshots,
+            period_rows: if self.info.recorded_periods > 1 {
+                let mut rows = std::mem::take(&mut self.period_rows);
+                rows.resize(self.info.recorded_periods as usize, 0);
+                rows
+            } else {
+                Vec::new()
+            },
         };
         let mut mcap = self.mcap.take().expect("finished once");
         let written =

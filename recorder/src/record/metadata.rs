@@ -86,6 +86,7 @@ pub(crate) fn recording_info(
         step_t0: run.step_t0,
         reference_periods: opts.reference_periods,
         twins: opts.twins,
+        recorded_periods: 1,
         area_encoding: opts.area_encoding,
         sqrt_area_unit: match opts.area_encoding {
             AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * run.r_max / SQRT_AREA_CODES,
@@ -120,6 +121,7 @@ impl Elapsed {
             seconds_reference: self.reference,
             seconds_recorder: self.recorder,
             seconds_twins: self.twins,
+            seconds_each_period: Vec::new(),
             stage_seconds,
             threads: rayon::current_num_threads(),
         }
