@@ -49,6 +49,13 @@ pub struct Sampling {
     pub reference_periods: u32,
     /// DEM twins continued from `t1` over the reference periods.
     pub twins: u32,
+    /// Consecutive periods recorded from `t0` (absent when 1, as in the file).
+    #[serde(skip_serializing_if = "is_one")]
+    pub recorded_periods: u32,
+}
+
+fn is_one(x: &u32) -> bool {
+    *x == 1
 }
 
 impl Sampling {
@@ -63,7 +70,22 @@ impl Sampling {
             t0: info.t0,
             reference_periods: info.reference_periods,
             twins: info.twins,
+            recorded_periods: info.recorded_periods,
         }
+    }
+
+    /// The line naming the recorded periods and the rows of each, when there are several.
+    pub fn print_recorded_periods(&self, period_rows: &[u64]) {
+        if self.recorded_periods < 2 {
+            return;
+        }
+        let rows: Vec<String> = period_rows.iter().map(u64::to_string).collect();
+        println!(
+            "recorded      {} periods, t0 to t{}, one after the other; rows in each: {}",
+            self.recorded_periods,
+            self.recorded_periods,
+            rows.join(", ")
+        );
     }
 
     /// The `period` line of the human summaries: `τ`, its steps (`= N steps of Δt`, or
@@ -145,6 +167,9 @@ struct Inspection {
     area_encoding: String,
     rows: u64,
     wall_rows: u64,
+    /// Rows of each recorded period, counted in the table (absent for one period).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    period_rows: Vec<u64>,
     batches: u64,
     contact_steps: u64,
     table_bytes: u64,
@@ -245,10 +270,18 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
         }
     })?;
     let (mut wall_rows, mut contact_steps) = (0u64, 0u64);
+    let mut period_rows = vec![0u64; info.recorded_periods as usize];
     let found = replay::scan(reader, &Bodies::of(&info, t0), |r, _| {
         wall_rows += (r.j >= info.particles) as u64;
         contact_steps += r.duration_steps as u64;
+        let period = info.period_of_step(r.start_step) as usize;
+        if let Some(rows) = period_rows.get_mut(period) {
+            *rows += 1;
+        }
     })?;
+    if info.recorded_periods == 1 {
+        period_rows.clear();
+    }
     let summary = reader.summary().cloned();
     let n = info.sample_every as u64;
     let histogram: Vec<HistogramBin> = summary.as_ref().map_or_else(Vec::new, |s| {
@@ -288,6 +321,7 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
         area_encoding: format!("{:?}", info.area_encoding).to_lowercase(),
         rows: found.rows,
         wall_rows,
+        period_rows,
         batches: found.batches,
         contact_steps,
         table_bytes: reader.table_bytes(),
@@ -352,6 +386,7 @@ fn print_human(s: &Inspection) {
         "table         {} rows ({} wall rows) in {} batches, {} contact-steps; {:.2} bytes per row ({:.1} MB)",
         s.rows, s.wall_rows, s.batches, s.contact_steps, s.bytes_per_row, s.table_bytes as f64 / 1e6
     );
+    s.sampling.print_recorded_periods(&s.period_rows);
     println!(
         "collisions    {} (durations: samples seen → steps)",
         s.collisions

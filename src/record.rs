@@ -20,11 +20,18 @@ struct RecordReport {
     costs_recorded: bool,
     rows: u64,
     wall_rows: u64,
+    /// Rows of each recorded period (absent for one period).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    period_rows: Vec<u64>,
     file_bytes: u64,
     table_bytes: u64,
     bytes_per_row: f64,
     seconds_to_t0: f64,
+    /// All recorded periods.
     seconds_period: f64,
+    /// Each recorded period, DEM and recorder (absent for one period).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    seconds_each_period: Vec<f64>,
     seconds_recorder: f64,
     seconds_reference: f64,
     /// The DEM twins' reference periods, all twins (0 without twins).
@@ -103,11 +110,13 @@ pub fn run(plan: RecordPlan) -> Result<()> {
         costs_recorded: reader.costs().is_some(),
         rows: summary.rows,
         wall_rows: summary.wall_rows,
+        period_rows: summary.period_rows.clone(),
         file_bytes: reader.file_bytes(),
         table_bytes: reader.table_bytes(),
         bytes_per_row: reader.table_bytes() as f64 / summary.rows.max(1) as f64,
         seconds_to_t0: costs.seconds_to_t0,
         seconds_period: costs.seconds_period,
+        seconds_each_period: costs.seconds_each_period.clone(),
         seconds_recorder: costs.seconds_recorder,
         seconds_reference: costs.seconds_reference,
         seconds_twins: costs.seconds_twins,
@@ -141,6 +150,7 @@ fn print_human(report: &RecordReport) {
         report.bytes_per_row,
         report.file_bytes as f64 / 1e6
     );
+    report.sampling.print_recorded_periods(&report.period_rows);
     let twins = report.sampling.twins;
     if twins > 0 {
         println!(
@@ -157,10 +167,35 @@ fn print_human(report: &RecordReport) {
         );
     }
     if report.costs_recorded {
+        // the reference snapshots up to tP are recorded ones: the DEM ran on for the rest
+        let (recorded, reference) = match report.sampling.recorded_periods {
+            1 => (
+                "the period".to_string(),
+                format!("{} reference periods", report.sampling.reference_periods),
+            ),
+            p => (
+                format!("the {p} recorded periods"),
+                format!(
+                    "{} reference periods after t{p}",
+                    (report.sampling.reference_periods + 1).saturating_sub(p)
+                ),
+            ),
+        };
         println!(
-            "time          {:.1} s to t0, {:.1} s for the period ({:.1} s of it recording), {:.1} s for {} reference periods",
-            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference, report.sampling.reference_periods
+            "time          {:.1} s to t0, {:.1} s for {recorded} ({:.1} s of it recording), {:.1} s for {reference}",
+            report.seconds_to_t0, report.seconds_period, report.seconds_recorder, report.seconds_reference
         );
+        if !report.seconds_each_period.is_empty() {
+            let each: Vec<String> = report
+                .seconds_each_period
+                .iter()
+                .map(|s| format!("{s:.1}"))
+                .collect();
+            println!(
+                "              {} s for each recorded period",
+                each.join(", ")
+            );
+        }
         if twins > 0 {
             println!(
                 "              {:.1} s for the twins' reference periods",

@@ -37,7 +37,7 @@ fn setup(dir: &Path) -> PathBuf {
     case
 }
 
-fn checkpoint_of(out: &Path) -> PathBuf {
+pub(crate) fn checkpoint_of(out: &Path) -> PathBuf {
     PathBuf::from(format!("{}.checkpoint", out.display()))
 }
 
@@ -53,7 +53,7 @@ fn record_args<'a>(case: &'a Path, out: &'a Path, extra: &[&'a str]) -> Vec<&'a 
     args
 }
 
-fn spawn(args: &[&str]) -> Child {
+pub(crate) fn spawn(args: &[&str]) -> Child {
     Command::new(tdex())
         .args(args)
         .stdout(Stdio::null())
@@ -64,7 +64,7 @@ fn spawn(args: &[&str]) -> Child {
 
 /// Waits until the checkpoint's first line says the run is at `stage` (e.g. "period step"),
 /// then kills the run with SIGKILL. Fails if the run ends first.
-fn kill_at(child: Child, checkpoint: &Path, stage: &str) -> String {
+pub(crate) fn kill_at(child: Child, checkpoint: &Path, stage: &str) -> String {
     kill_when(child, checkpoint, stage, |line| line.contains(stage))
 }
 
@@ -116,7 +116,7 @@ fn kill_when(
 
 /// Resumes the run of checkpoint `ck_arg` to its end and asserts that the recording `b` it
 /// writes is `a`, the uninterrupted run's, byte for byte (`stops`: where it was killed).
-fn resume_to_the_end(ck_arg: &str, a: &Path, b: &Path, stops: &[String]) {
+pub(crate) fn resume_to_the_end(ck_arg: &str, a: &Path, b: &Path, stops: &[String]) {
     let o = run_tdex(&["record", "--resume", ck_arg]);
     assert!(
         o.status.success(),
@@ -307,7 +307,7 @@ fn checkpoints_with_a_valid_crc_but_altered_state_never_panic() {
             for _ in 0..20 {
                 sim.step();
             }
-            if let (Stage::Period { done }, Some(out)) = (stage, output) {
+            if let (Stage::Period { done, .. }, Some(out)) = (stage, output) {
                 let mut sampler = out.sampler.into_owned();
                 let every = sampler.every as u64;
                 for k in 0..3 {

@@ -12,6 +12,7 @@ mod cli_import;
 mod cli_inspect;
 mod cli_outputs;
 mod cli_record;
+mod cli_recorded_periods;
 mod cli_report;
 mod cli_run;
 mod cli_study;

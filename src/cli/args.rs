@@ -101,6 +101,16 @@ pub struct RecordArgs {
     /// `report` judge the extrapolation. Each twin costs the reference periods again.
     #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=16), requires = "reference")]
     pub twins: u32,
+    /// Record P consecutive periods of the run from t0 (1 to 64): P collision tables one
+    /// after the other and the snapshots t0 … tP; the extrapolation replays them in turn.
+    /// The reference snapshots up to tP are the recorded ones.
+    #[arg(
+        long = "recorded-periods",
+        value_name = "P",
+        default_value_t = 1,
+        value_parser = clap::value_parser!(u32).range(1..=tdex_format::MAX_RECORDED_PERIODS as i64)
+    )]
+    pub recorded_periods: u32,
     /// Worker threads (default: all cores). The recording does not depend on it.
     #[arg(long, value_parser = threads())]
     pub threads: Option<usize>,
@@ -122,7 +132,7 @@ pub struct RecordArgs {
     #[arg(
         long,
         value_name = "CHECKPOINT",
-        conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "reproducible"]
+        conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "recorded_periods", "reproducible"]
     )]
     pub resume: Option<PathBuf>,
     /// Leave out the costs record (wall times, thread count): the same case, seed and

@@ -309,6 +309,7 @@ impl RecordStart {
                     )));
                 }
                 options.twins = twins;
+                options.recorded_periods = args.recorded_periods;
                 Ok(RecordStart::Fresh {
                     case_path: case,
                     case_toml,
@@ -539,6 +540,7 @@ pub(crate) fn record_options(
         period_steps,
         reference_periods: reference,
         twins: 0,
+        recorded_periods: 1,
         area_encoding,
     })
 }

@@ -95,11 +95,18 @@ pub fn decode(bytes: &[u8], info: &RecordingInfo) -> Result<TableBatch, String> 
                 row.duration_steps, info.dtc_max_steps
             ));
         }
+        // a row ends by the end of its recorded period: rows are cut at the boundaries
+        let period = info.period_of_step(row.start_step);
+        let period_end = (period + 1).checked_mul(info.period_steps);
         let end = row.start_step.checked_add(row.duration_steps as u64);
-        if end.is_none_or(|end| end > info.period_steps) || row.start_step < previous_start {
+        let beyond = match (end, period_end) {
+            (Some(end), Some(period_end)) => end > period_end,
+            _ => true,
+        };
+        if period >= info.recorded_periods as u64 || beyond || row.start_step < previous_start {
             return bad(format!(
-                "start step {} (duration {}) out of apparition order or beyond the period of {} steps",
-                row.start_step, row.duration_steps, info.period_steps
+                "start step {} (duration {}) out of apparition order or beyond its recorded period ({} of {} steps)",
+                row.start_step, row.duration_steps, info.recorded_periods, info.period_steps
             ));
         }
         if !(row.sqrt_area.is_finite() && row.sqrt_area >= 0.0) {

@@ -94,6 +94,8 @@ pub fn import(
     let opts = RecordOptions {
         reference_periods,
         twins: 0,
+        // the dumps hold one period
+        recorded_periods: 1,
         ..opts.clone()
     };
     let info = recording_info(case, case_path, case_toml, &opts, run);

@@ -33,8 +33,11 @@ use tdex_format::Snapshot;
 /// Format of the body; a reader refuses others. v2: the Verlet list's pair histories are
 /// packed layer by layer (v1 had one per entry). v3: one stage timer for pair and wall
 /// contacts (`contact`) instead of `pair` and `wall`. v4: DEM twins (the state at `t1` kept
-/// while the runs that continue from it go on, the twin stage, the twins' wall time).
-pub const CHECKPOINT_VERSION: u32 = 4;
+/// while the runs that continue from it go on, the twin stage, the twins' wall time). v5:
+/// several recorded periods (the recorded period's index in the stage, the recording option
+/// `recorded_periods`, each period's wall time; the state at `t1` also kept inside recorded
+/// periods after the first while twins are to come).
+pub const CHECKPOINT_VERSION: u32 = 5;
 const HEADER_PREFIX: &str = "tdex checkpoint v";
 /// The header line is at most this long (a reader does not scan a large file for it).
 const MAX_HEADER: usize = 512;
@@ -53,9 +56,12 @@ pub enum Stage {
     Settle { done: u64 },
     /// `done` steps of the spin-up.
     SpinUp { done: u64 },
-    /// `done` steps of the recorded period `[t0, t1]`.
-    Period { done: u64 },
-    /// `done` steps into reference period `period` (0-based; the ones before it are stored).
+    /// `done` steps into recorded period `period` (0-based: `[t_period, t_(period+1)]`; the
+    /// ones before it are stored).
+    Period { period: u32, done: u64 },
+    /// `done` steps into reference period `period` (0-based, its snapshot is `t_(period+2)`;
+    /// the ones before it are stored). The first to run is the one after the recorded
+    /// periods: those up to `tP` are recorded ones.
     Reference { period: u32, done: u64 },
     /// `done` steps into reference period `period` of DEM twin `twin` (1-based; the twins
     /// before it and its periods before `period` are stored).
@@ -97,10 +103,10 @@ impl<'a> EngineState<'a> {
 #[derive(Debug, Serialize, Deserialize)]
 pub struct OutputState<'a> {
     pub run: RunAtT0,
-    /// `t0`, then `t1` and the reference snapshots written so far, then those of the DEM
-    /// twins (twin 1's `t2..`, twin 2's, ...).
+    /// `t0`, then the recorded and reference snapshots written so far (`t1`, `t2`, ... in
+    /// order), then those of the DEM twins (twin 1's `t2..`, twin 2's, ...).
     pub snapshots: Cow<'a, [Snapshot]>,
-    /// The engine at `t1`, kept while DEM twins are still to continue from it.
+    /// The engine at `t1`, kept from `t1` on while DEM twins are still to continue from it.
     pub t1_engine: Option<EngineState<'a>>,
     pub sampler: Cow<'a, ContactSampler>,
     pub journal: JournalMark,
@@ -261,8 +267,8 @@ impl Checkpoint<'static> {
 
     /// Rebuilds the simulation of `case` with the saved state, after checking that every
     /// index the engine and the recorder will follow is in range (a checkpoint that passed
-    /// its CRC can still have been written by hand). `period_steps` and `reference_periods`
-    /// bound the stage; `path` is for messages.
+    /// its CRC can still have been written by hand). `period_steps`, `recorded_periods` and
+    /// `reference_periods` bound the stage; `path` is for messages.
     pub fn restore(self, case: &Case, path: &Path) -> Result<Restored, CheckpointError> {
         let bad = |detail: String| CheckpointError::Inconsistent {
             path: path.to_path_buf(),
@@ -275,27 +281,32 @@ impl Checkpoint<'static> {
             case.steps_in(case.time.settle),
             case.steps_in(case.time.spin_up),
         );
+        let recorded = o.recorded_periods;
+        // the run's own snapshots: t0 up to tP or to the last reference t_(K+1)
+        let own = recorded.max(o.reference_periods.saturating_add(1)) as usize + 1;
         let (stage_ok, snapshots) = match self.stage {
             Stage::Settle { done } => (done <= settle, None),
             Stage::SpinUp { done } => (done <= spin, None),
-            Stage::Period { done } => (
-                done <= o.period_steps && done % o.sample_every.max(1) as u64 == 0,
-                Some(1),
+            Stage::Period { period, done } => (
+                period < recorded
+                    && done <= o.period_steps
+                    && done % o.sample_every.max(1) as u64 == 0,
+                Some(1 + period as usize),
             ),
             Stage::Reference { period, done } => (
-                period < o.reference_periods && done <= o.period_steps,
+                period < o.reference_periods && period + 1 >= recorded && done <= o.period_steps,
                 Some(2 + period as usize),
             ),
             Stage::Twin { twin, period, done } => (
                 (1..=o.twins).contains(&twin)
                     && period < o.reference_periods
                     && done <= o.period_steps,
-                Some(2 + (o.reference_periods as usize) * twin as usize + period as usize),
+                Some(own + (o.reference_periods as usize) * (twin as usize - 1) + period as usize),
             ),
         };
-        if !stage_ok {
+        if !(1..=tdex_format::MAX_RECORDED_PERIODS).contains(&recorded) || !stage_ok {
             return Err(bad(format!(
-                "stage {:?} is outside the run ({settle} settling, {spin} spin-up steps, period of {} steps sampled every {}, {} reference periods)",
+                "stage {:?} is outside the run ({settle} settling, {spin} spin-up steps, {recorded} recorded periods of {} steps sampled every {}, {} reference periods)",
                 self.stage, o.period_steps, o.sample_every, o.reference_periods
             )));
         }
@@ -344,7 +355,7 @@ impl Checkpoint<'static> {
                     .map_err(&bad)?;
                 // the main run's snapshots are numbered by position, each twin's from 2
                 let references = o.reference_periods.max(1) as usize;
-                let expected = |k: usize| match k.checked_sub(2 + references) {
+                let expected = |k: usize| match k.checked_sub(own) {
                     None => k,
                     Some(past) => 2 + past % references,
                 };
@@ -358,6 +369,7 @@ impl Checkpoint<'static> {
                 }
                 // the state at t1 is kept from t1 on while twins are still to run from it
                 let keeps_t1 = match self.stage {
+                    Stage::Period { period, .. } => period > 0 && o.twins > 0,
                     Stage::Reference { .. } => o.twins > 0,
                     Stage::Twin { .. } => true,
                     _ => false,

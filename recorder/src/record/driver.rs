@@ -1,13 +1,15 @@
-//! The recorder's driver: runs a case to `t0`, records the period `[t0, t1]`, the reference
-//! periods and the DEM twins into one recording (checkpointed when asked) or into several
-//! samplings of one run; the entry points of `tdex record` and of the studies.
+//! The recorder's driver: runs a case to `t0`, records the periods `[t0, t1]` … `[t(P-1),
+//! tP]`, the reference periods and the DEM twins into one recording (checkpointed when asked)
+//! or into several samplings of one run; the entry points of `tdex record` and of the studies.
 
-use super::checkpoint::{checkpoint_path, Checkpoint, EngineState, OutputState, Restored, Stage};
+use super::checkpoint::{
+    checkpoint_path, Checkpoint, CheckpointError, EngineState, OutputState, Restored, Stage,
+};
 use super::error::RecordError;
 use super::journal::{JournalMark, RowJournal};
 use super::metadata::{recording_info, stage_seconds, Elapsed, RunAtT0};
 use super::options::{Phase, RecordJob, RecordOptions, RecordRun, REPORT_EVERY};
-use super::period::{record_period, PeriodCheckpoint, RecorderState, RowSink};
+use super::period::{record_period, PeriodCheckpoint, RecordedPeriod, RecorderState, RowSink};
 use super::saver::Saver;
 use super::ContactSampler;
 use crate::case::Case;
@@ -102,8 +104,8 @@ pub fn run_to_t0(
     Ok(sim)
 }
 
-/// Records the period `[t0, t1]` of a simulation standing at `t0` (and the reference
-/// periods) into `dest`.
+/// Records the periods from `t0` of a simulation standing there (and the reference periods)
+/// into `dest`.
 pub fn record_from_t0(
     sim: &mut Simulation,
     case_path: &Path,
@@ -123,12 +125,13 @@ pub fn record_from_t0(
 }
 
 /// Records several samplings of one DEM run: the simulation standing at `t0` is stepped
-/// once through the period and the reference periods, and every job's sampler is fed the
+/// once through the recorded and the reference periods, and every job's sampler is fed the
 /// contact list at its own steps (`k` a multiple of its `n`). Sampling only reads the state,
 /// so each file holds the table and snapshots that a run with its options alone would write;
-/// only the costs differ: `seconds_period` is the period's wall time (shared) and
+/// only the costs differ: `seconds_period` is the recorded periods' wall time (shared) and
 /// `seconds_recorder` the job's own sampler, splitter and writer time. Jobs must share
-/// `period_steps` and `reference_periods`; DEM twins are recorded by [`record_run`] alone.
+/// `period_steps`, `recorded_periods` and `reference_periods`; DEM twins are recorded by
+/// [`record_run`] alone.
 pub fn record_many_from_t0(
     sim: &mut Simulation,
     case_path: &Path,
@@ -137,10 +140,14 @@ pub fn record_many_from_t0(
     seconds_to_t0: f64,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<Vec<RecordingSummary>, RecordError> {
-    let shared = |j: &RecordJob| (j.options.period_steps, j.options.reference_periods);
+    let shared = |j: &RecordJob| {
+        let o = &j.options;
+        (o.period_steps, o.recorded_periods, o.reference_periods)
+    };
     if jobs.windows(2).any(|w| shared(&w[0]) != shared(&w[1])) {
         return Err(RecordError::Settings(
-            "the recordings of one run must share τ and the reference periods".into(),
+            "the recordings of one run must share τ, the recorded periods and the reference              periods"
+                .into(),
         ));
     }
     if jobs.iter().any(|j| j.options.twins > 0) {
@@ -224,6 +231,13 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
             opts.period_steps
         )));
     }
+    let most = tdex_format::MAX_RECORDED_PERIODS;
+    if !(1..=most).contains(&opts.recorded_periods) {
+        return Err(RecordError::Settings(format!(
+            "{} recorded periods: between 1 and {most} are recorded",
+            opts.recorded_periods
+        )));
+    }
     if opts.twins > tdex_format::MAX_TWINS || (opts.twins > 0 && opts.reference_periods == 0) {
         return Err(RecordError::Settings(format!(
             "{} DEM twins with {} reference periods: twins run over the reference periods, so \
@@ -275,7 +289,7 @@ fn advance_to_t0(
             &mut |sim, done| checkpoint(sim, Stage::SpinUp { done }),
         )?;
         sim.assign_temperatures();
-        stage = Stage::Period { done: 0 };
+        stage = Stage::Period { period: 0, done: 0 };
     }
     Ok(stage)
 }
@@ -323,8 +337,8 @@ fn check_twin_differs(
     Ok(())
 }
 
-/// The whole run from wherever it stands: settle, spin-up, the recorded period, the
-/// reference periods, the DEM twins, with checkpoints when `saver` is given (a run with one
+/// The whole run from wherever it stands: settle, spin-up, the recorded periods, the
+/// reference periods after them, the DEM twins, with checkpoints when `saver` is given (a run with one
 /// recording). Returns each recording's summary, in the order of the jobs.
 fn drive(
     dem: &DemRun,
@@ -337,7 +351,7 @@ fn drive(
         .iter()
         .map(|j| check(&j.options))
         .collect::<Result<Vec<_>, _>>()?;
-    // what the recordings share: τ, the reference periods and the twins
+    // what the recordings share: τ, the recorded and reference periods and the twins
     let Some(opts) = dem.jobs.first().map(|j| &j.options) else {
         return Ok(Vec::new());
     };
@@ -353,7 +367,13 @@ fn drive(
                 to_t0: seconds_to_t0,
                 ..Elapsed::default()
             };
-            (sim, Stage::Period { done: 0 }, elapsed, None, None)
+            (
+                sim,
+                Stage::Period { period: 0, done: 0 },
+                elapsed,
+                None,
+                None,
+            )
         }
         Start::Restored(r) => {
             let r = *r;
@@ -367,7 +387,7 @@ fn drive(
         let (began, base) = (Instant::now(), elapsed.to_t0);
         let to_t0 = |elapsed: &Elapsed| Elapsed {
             to_t0: base + began.elapsed().as_secs_f64(),
-            ..*elapsed
+            ..elapsed.clone()
         };
         stage = advance_to_t0(sim, stage, progress, &mut |sim, stage| match &mut saver {
             Some(s) if s.due() => s.save(sim, stage, to_t0(&elapsed), None),
@@ -412,14 +432,42 @@ fn drive(
             let mut writer = RecordingWriter::create(dem.jobs[0].dest, info)?;
             writer.write_snapshot(&out.snapshots[0])?;
             let path = journal.as_ref().expect("a resumed run keeps checkpointing");
-            let journal = RowJournal::resume(path, out.journal, &mut |rows| {
-                writer
-                    .push_rows(rows.iter().copied())
-                    .map_err(RecordError::from)
+            // the rows and the recorded snapshots in the order the run wrote them (a snapshot
+            // closes the chunk before it): t_k after the rows of period k - 1, before the first
+            // row of a later period
+            let mut next = 1;
+            let journal = RowJournal::resume(path, out.journal, &mut |mut rows| {
+                while let Some(first) = rows.first() {
+                    let period = first.start_step / opts.period_steps;
+                    while next as u64 <= period {
+                        let snapshot = out.snapshots.get(next).ok_or_else(|| {
+                            CheckpointError::Inconsistent {
+                                path: saver.as_ref().map_or_else(Default::default, |s| s.path()),
+                                detail: format!(
+                                    "its row journal holds rows of recorded period {period}, its \
+                                     snapshots end at t{}",
+                                    next - 1
+                                ),
+                            }
+                        })?;
+                        writer.write_snapshot(snapshot)?;
+                        next += 1;
+                    }
+                    let same = rows
+                        .iter()
+                        .position(|r| r.start_step / opts.period_steps != period)
+                        .unwrap_or(rows.len());
+                    writer.push_rows(rows[..same].iter().copied())?;
+                    rows = &rows[same..];
+                }
+                Ok::<_, RecordError>(())
             })?;
-            // the run's own snapshots, then each twin's, in the order they were written
-            let own = 2 + opts.reference_periods as usize;
-            for (k, snapshot) in out.snapshots.iter().enumerate().skip(1) {
+            // the run's own snapshots left, then each twin's, in the order they were written
+            let own = opts
+                .recorded_periods
+                .max(opts.reference_periods.saturating_add(1)) as usize
+                + 1;
+            for (k, snapshot) in out.snapshots.iter().enumerate().skip(next) {
                 match k.checked_sub(own) {
                     None => writer.write_snapshot(snapshot)?,
                     Some(past) => writer.write_twin_snapshot(
@@ -444,57 +492,84 @@ fn drive(
     // seconds `elapsed.recorder` carries
     let mut recorder_seconds = vec![elapsed.recorder; sinks.len()];
 
-    // the recorded period
-    if let Stage::Period { done } = stage {
-        let began = Instant::now();
-        let mut hook = PeriodSaver {
-            saver: saver.as_mut(),
-            run_at_t0: &run_at_t0,
-            t0: &snapshots[0],
-            elapsed,
-            began,
-        };
-        let checkpoints: Option<&mut dyn PeriodCheckpoint> = match hook.saver {
-            Some(_) => Some(&mut hook),
-            None => None,
-        };
+    // DEM twins are checked against the run's t2 (a recorded snapshot when P ≥ 2)
+    let mut dem_t2 = snapshots.get(2).filter(|_| opts.twins > 0).cloned();
+
+    // the recorded periods, one after the other: the samplers are cut at each boundary
+    if let Stage::Period {
+        period: first,
+        done,
+    } = stage
+    {
+        let recorded = opts.recorded_periods;
         let every: Vec<u64> = dem
             .jobs
             .iter()
             .map(|j| j.options.sample_every as u64)
             .collect();
-        let busy;
-        (samplers, busy) = record_period(
-            sim,
-            samplers,
-            &mut sinks,
-            &every,
-            opts.period_steps,
-            done,
-            checkpoints,
-            progress,
-        )?;
-        let t1 = sim.snapshot(1);
-        for ((sink, seconds), busy) in sinks.iter_mut().zip(&mut recorder_seconds).zip(busy) {
-            let t = Instant::now();
-            sink.writer.write_snapshot(&t1)?;
-            *seconds += busy + t.elapsed().as_secs_f64();
+        elapsed.each_period.resize(recorded as usize, 0.0);
+        for index in first..recorded {
+            let began = Instant::now();
+            let mut hook = PeriodSaver {
+                saver: saver.as_mut(),
+                run_at_t0: &run_at_t0,
+                snapshots: &snapshots,
+                at_t1: at_t1.as_ref(),
+                period: index,
+                elapsed: elapsed.clone(),
+                began,
+            };
+            let checkpoints: Option<&mut dyn PeriodCheckpoint> = match hook.saver {
+                Some(_) => Some(&mut hook),
+                None => None,
+            };
+            let period = RecordedPeriod {
+                index,
+                count: recorded,
+                steps: opts.period_steps,
+            };
+            let start = if index == first { done } else { 0 };
+            let busy;
+            (samplers, busy) = record_period(
+                sim,
+                samplers,
+                &mut sinks,
+                &every,
+                period,
+                start,
+                checkpoints,
+                progress,
+            )?;
+            let snapshot = sim.snapshot(index + 1);
+            for ((sink, seconds), busy) in sinks.iter_mut().zip(&mut recorder_seconds).zip(busy) {
+                let t = Instant::now();
+                sink.writer.write_snapshot(&snapshot)?;
+                *seconds += busy + t.elapsed().as_secs_f64();
+            }
+            if index == 0 && opts.twins > 0 {
+                at_t1 = Some(sim.clone());
+            }
+            if snapshot.index == 2 && opts.twins > 0 {
+                dem_t2 = Some(snapshot.clone());
+            }
+            // kept only for the checkpoints: a snapshot is 68 B a particle
+            if saver.is_some() {
+                snapshots.push(snapshot);
+            }
+            elapsed.recorder = recorder_seconds[0];
+            let seconds = began.elapsed().as_secs_f64();
+            elapsed.period += seconds;
+            elapsed.each_period[index as usize] += seconds;
         }
-        if opts.twins > 0 {
-            at_t1 = Some(sim.clone());
-        }
-        // kept only for the checkpoints: a snapshot is 68 B a particle
-        if saver.is_some() {
-            snapshots.push(t1);
-        }
-        elapsed.recorder = recorder_seconds[0];
-        elapsed.period += began.elapsed().as_secs_f64();
-        stage = Stage::Reference { period: 0, done: 0 };
+        // the reference periods go on after tP (those up to tP are recorded ones)
+        stage = Stage::Reference {
+            period: recorded - 1,
+            done: 0,
+        };
     }
 
     // the reference periods, then the DEM twins, each from t1 over the same periods (the
     // run's own t2 is kept to check that the twins differ from it)
-    let mut dem_t2: Option<Snapshot> = None;
     let mut main_stage_seconds = None;
     if matches!(stage, Stage::Reference { .. } | Stage::Twin { .. }) {
         let mark = match sinks.first_mut().and_then(|s| s.journal.as_mut()) {
@@ -522,11 +597,11 @@ fn drive(
                 (first, done),
                 &mut snapshots,
                 progress,
-                &mut |period, snapshot| {
+                &mut |_, snapshot| {
                     for sink in sinks.iter_mut() {
                         sink.writer.write_snapshot(snapshot)?;
                     }
-                    if period == 0 && opts.twins > 0 {
+                    if snapshot.index == 2 && opts.twins > 0 {
                         dem_t2 = Some(snapshot.clone());
                     }
                     Ok(())
@@ -552,9 +627,6 @@ fn drive(
             let t1 = at_t1.as_ref().ok_or_else(|| {
                 RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
             })?;
-            if dem_t2.is_none() {
-                dem_t2 = snapshots.get(2).cloned();
-            }
             for twin in first..=opts.twins {
                 if twin != first {
                     *sim = twin_of(t1, twin);
@@ -583,7 +655,7 @@ fn drive(
             }
             past_t1.stage_done(Continuation::Twin(first));
         }
-        elapsed = past_t1.elapsed;
+        elapsed = past_t1.elapsed.clone();
     }
 
     // the run's own stages; a run resumed among its twins has only the last twin's, which
@@ -597,7 +669,7 @@ fn drive(
             let costs = dem.write_costs.then(|| {
                 Elapsed {
                     recorder,
-                    ..elapsed
+                    ..elapsed.clone()
                 }
                 .costs(stage_seconds.clone())
             });
@@ -638,7 +710,7 @@ impl Continuation {
 /// What the runs past `t1` need to checkpoint themselves: the output's state (fixed since
 /// `t1`), the state at `t1` while twins are to come, and the wall time of the stage.
 struct PastT1<'a, 's> {
-    /// What the recordings share: τ, the reference periods.
+    /// What the recordings share: τ, the recorded and the reference periods.
     opts: &'a RecordOptions,
     saver: Option<&'a mut Saver<'s>>,
     mark: Option<JournalMark>,
@@ -657,11 +729,11 @@ impl PastT1<'_, '_> {
         match which {
             Continuation::Reference => Elapsed {
                 reference: self.elapsed.reference + now,
-                ..self.elapsed
+                ..self.elapsed.clone()
             },
             Continuation::Twin(_) => Elapsed {
                 twins: self.elapsed.twins + now,
-                ..self.elapsed
+                ..self.elapsed.clone()
             },
         }
     }
@@ -672,7 +744,8 @@ impl PastT1<'_, '_> {
         self.began = Instant::now();
     }
 
-    /// Runs the reference periods of `which` from `(period, done)` on, offering checkpoints
+    /// Runs the reference periods of `which` from `(period, done)` on (none when the recorded
+    /// periods reach past them), offering checkpoints
     /// between blocks of steps; each period's snapshot goes to `stored` (its index is
     /// `period + 2`) and, when the run is checkpointed, into `snapshots`.
     fn periods(
@@ -723,12 +796,16 @@ impl PastT1<'_, '_> {
     }
 }
 
-/// The checkpoints of the recorded period: the engine from the DEM thread, the samplers and
+/// The checkpoints of a recorded period: the engine from the DEM thread, the samplers and
 /// journal marks from the recorder thread, the rest from the driver.
 struct PeriodSaver<'a, 's> {
     saver: Option<&'a mut Saver<'s>>,
     run_at_t0: &'a RunAtT0,
-    t0: &'a Snapshot,
+    /// `t0 … t_period`, the snapshots stored before this period.
+    snapshots: &'a [Snapshot],
+    /// The engine at `t1`, in the periods after the first while DEM twins are to come.
+    at_t1: Option<&'a Simulation>,
+    period: u32,
     /// Elapsed times when the period (re)started.
     elapsed: Elapsed,
     began: Instant,
@@ -755,16 +832,22 @@ impl PeriodCheckpoint for PeriodSaver<'_, '_> {
         };
         let output = OutputState {
             run: self.run_at_t0.clone(),
-            snapshots: Cow::Borrowed(std::slice::from_ref(self.t0)),
+            snapshots: Cow::Borrowed(self.snapshots),
             sampler: Cow::Borrowed(sampler),
             journal: *journal,
-            t1_engine: None,
+            t1_engine: self.at_t1.map(EngineState::of),
         };
-        let elapsed = Elapsed {
-            period: self.elapsed.period + self.began.elapsed().as_secs_f64(),
+        let seconds = self.began.elapsed().as_secs_f64();
+        let mut elapsed = Elapsed {
+            period: self.elapsed.period + seconds,
             recorder: self.elapsed.recorder + recorder.busy[0],
-            ..self.elapsed
+            ..self.elapsed.clone()
         };
-        saver.save(sim, Stage::Period { done }, elapsed, Some(output))
+        elapsed.each_period[self.period as usize] += seconds;
+        let stage = Stage::Period {
+            period: self.period,
+            done,
+        };
+        saver.save(sim, stage, elapsed, Some(output))
     }
 }

@@ -86,7 +86,7 @@ pub(crate) fn recording_info(
         step_t0: run.step_t0,
         reference_periods: opts.reference_periods,
         twins: opts.twins,
-        recorded_periods: 1,
+        recorded_periods: opts.recorded_periods,
         area_encoding: opts.area_encoding,
         sqrt_area_unit: match opts.area_encoding {
             AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * run.r_max / SQRT_AREA_CODES,
@@ -101,10 +101,14 @@ pub(crate) fn recording_info(
 }
 
 /// Wall-clock seconds spent so far, as the costs record reports them.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Elapsed {
     pub to_t0: f64,
+    /// All recorded periods.
     pub period: f64,
+    /// Each recorded period's share of `period` (one entry per recorded period once the
+    /// recording has started).
+    pub each_period: Vec<f64>,
     pub recorder: f64,
     pub reference: f64,
     /// The DEM twins' reference periods.
@@ -121,7 +125,12 @@ impl Elapsed {
             seconds_reference: self.reference,
             seconds_recorder: self.recorder,
             seconds_twins: self.twins,
-            seconds_each_period: Vec::new(),
+            // one period: `seconds_period` says it all
+            seconds_each_period: if self.each_period.len() > 1 {
+                self.each_period.clone()
+            } else {
+                Vec::new()
+            },
             stage_seconds,
             threads: rayon::current_num_threads(),
         }

@@ -4,7 +4,7 @@
 //!
 //! The modules, from the bottom: `options` and `metadata` (what a recording is asked for
 //! and what its metadata says), `checkpoint` and `journal` (a run's saved state), `period`
-//! (the recorded period's DEM and recorder threads) and `saver` (the checkpoints of a run),
+//! (a recorded period's DEM and recorder threads) and `saver` (the checkpoints of a run),
 //! and `driver` on top, the only one that knows the order of the stages.
 
 pub mod checkpoint;

@@ -19,6 +19,9 @@ pub struct RecordOptions {
     /// DEM twins: further runs continued from the state at `t1` over the reference periods,
     /// twin `m` with the drum's angular velocity changed by `m` units in the last place.
     pub twins: u32,
+    /// Consecutive periods recorded from `t0` (`P`, 1 to [`tdex_format::MAX_RECORDED_PERIODS`]):
+    /// `P` collision tables, one after the other, and the snapshots `t0 … tP`.
+    pub recorded_periods: u32,
     pub area_encoding: AreaEncoding,
 }
 

@@ -1,4 +1,4 @@
-//! The recorded period's two threads: the DEM steps on the caller's thread while a recorder
+//! A recorded period's two threads: the DEM steps on the caller's thread while a recorder
 //! thread samples, splits, encodes and writes each recording's rows.
 
 use super::error::RecordError;
@@ -45,6 +45,22 @@ pub(super) trait PeriodCheckpoint {
     ) -> Result<(), RecordError>;
 }
 
+/// Recorded period `index` (0-based) of `count`, `steps` DEM steps long: its samples are
+/// numbered from `t0`, so its rows start in `[index · steps, (index + 1) · steps)`.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct RecordedPeriod {
+    pub(super) index: u32,
+    pub(super) count: u32,
+    pub(super) steps: u64,
+}
+
+impl RecordedPeriod {
+    /// Its first step, counted from `t0`.
+    fn first_step(self) -> u64 {
+        self.index as u64 * self.steps
+    }
+}
+
 /// Contact lists in flight between the DEM and the recorder thread.
 const SAMPLES_IN_FLIGHT: usize = 4;
 
@@ -60,15 +76,17 @@ type Sample = Vec<(u32, u32, f64)>;
 
 /// What the DEM thread sends the recorder thread.
 enum ToRecorder {
-    /// The contact list at step `k` of the period.
+    /// The contact list at step `k` counted from `t0`.
     Sample(u64, Sample),
     /// Everything sent before has been recorded: reply with the state for a checkpoint.
     Checkpoint(mpsc::Sender<RecorderState>),
 }
 
-/// The period `[t0, t1]` from step `start` on: the DEM steps on the calling thread (and its
-/// pool) while a recorder thread samples, splits, encodes and writes for every job (sampler
-/// `i` takes the steps that are multiples of `every[i]`). Each sample is the contact list
+/// Recorded period `period` from its step `start` on: the DEM steps on the calling thread
+/// (and its pool) while a recorder thread samples, splits, encodes and writes for every job
+/// (sampler `i` takes the steps that are multiples of `every[i]`). At its end the samplers
+/// cut the contacts still open ([`ContactSampler::finish`]): no row crosses the boundary, and
+/// the next period's first sample opens new rows. Each sample is the contact list
 /// copied at its step, so the tables are the same as a serial recorder's, whatever the
 /// timing; the recorder fills the cores the DEM leaves idle instead of stalling it. Between
 /// steps, `checkpoints` is offered the state when one is due. Returns the finished samplers
@@ -79,7 +97,7 @@ pub(super) fn record_period(
     mut samplers: Vec<ContactSampler>,
     sinks: &mut [RowSink],
     every: &[u64],
-    period_steps: u64,
+    period: RecordedPeriod,
     start: u64,
     mut checkpoints: Option<&mut dyn PeriodCheckpoint>,
     progress: &mut dyn FnMut(Phase, u64, u64),
@@ -126,17 +144,21 @@ pub(super) fn record_period(
                 Ok((samplers, busy))
             },
         );
+        let (first, period_steps) = (period.first_step(), period.steps);
+        let stretch = period.count as u64 * period_steps;
         let mut dem = || -> Result<(), RecordError> {
             let mut k = start;
             while k < period_steps {
                 // sample k is the contact list that conducted during DEM step k, from
                 // t0 + k dt to t0 + (k+1) dt: the list the step has just computed
                 sim.step();
+                // τ is a multiple of every n: the period's first step is too
                 if every.iter().any(|e| k.is_multiple_of(*e)) {
                     let mut contacts = spare.try_recv().unwrap_or_default();
                     contacts.clear();
                     contacts.extend(sim.touching_pairs().chain(sim.touching_walls()));
-                    if to_recorder.send(ToRecorder::Sample(k, contacts)).is_err() {
+                    let sample = ToRecorder::Sample(first + k, contacts);
+                    if to_recorder.send(sample).is_err() {
                         return Ok(()); // the recorder stopped: its error is reported below
                     }
                 }
@@ -146,7 +168,7 @@ pub(super) fn record_period(
                 sim.check_inside()?;
                 k += stride;
                 if k % REPORT_EVERY < stride || k == period_steps {
-                    progress(Phase::Period, k, period_steps);
+                    progress(Phase::Period, first + k, stretch);
                 }
                 if let Some(c) = checkpoints.as_deref_mut() {
                     if k < period_steps && c.due() {

@@ -55,6 +55,11 @@ impl<'a> Saver<'a> {
         })
     }
 
+    /// The checkpoint file.
+    pub(super) fn path(&self) -> PathBuf {
+        self.path.clone()
+    }
+
     pub(super) fn due(&self) -> bool {
         self.last.elapsed() >= self.every
     }
@@ -109,7 +114,15 @@ fn describe(stage: Stage, run: &RecordRun) -> String {
     match stage {
         Stage::Settle { done } => format!("settle step {done} of {}", c.steps_in(c.time.settle)),
         Stage::SpinUp { done } => format!("spin-up step {done} of {}", c.steps_in(c.time.spin_up)),
-        Stage::Period { done } => format!("period step {done} of {}", o.period_steps),
+        Stage::Period { period: _, done } if o.recorded_periods == 1 => {
+            format!("period step {done} of {}", o.period_steps)
+        }
+        Stage::Period { period, done } => format!(
+            "recorded period {} of {} step {done} of {}",
+            period + 1,
+            o.recorded_periods,
+            o.period_steps
+        ),
         Stage::Reference { period, done } => format!(
             "reference period {} of {} step {done} of {}",
             period + 1,
