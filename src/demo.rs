@@ -68,6 +68,8 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         table: TableChoice::InMemoryIfItFits,
         memory_limit: extrapolation::memory_limit(None),
         reproducible: false,
+        recorded_periods: None,
+        path_seed: None,
     };
     let outcome = crate::with_workers(plan.threads, || {
         Ok(extrapolate::extrapolate_recording(

@@ -10,6 +10,7 @@ use extrapolate::{
     ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice,
 };
 use serde::Serialize;
+use tdex_format::extrapolation::{RecurrencePath, Roles};
 use tdex_format::ExtrapolationCosts;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
@@ -23,7 +24,9 @@ struct ExtrapolationReport {
     max_cfl: f64,
     table_in_memory: bool,
     memory: MemoryReport,
-    pairing: PairingSummary,
+    /// `pairing` (one recorded period) or `path` (several).
+    #[serde(flatten)]
+    roles: RolesReport,
     costs: ExtrapolationCosts,
     total_heat_t1: f64,
     total_heat_end: f64,
@@ -40,12 +43,69 @@ impl ExtrapolationReport {
             max_cfl: outcome.max_cfl,
             table_in_memory: outcome.memory.mode == TableMode::InMemory,
             memory: MemoryReport::of(&outcome.memory, &outcome.limit),
-            pairing: outcome.pairing,
+            roles: match outcome.roles {
+                Roles::Pairing(pairing) => RolesReport::Pairing(pairing),
+                Roles::Path(path) => RolesReport::Path(PathReport {
+                    jumps: path.jumps(),
+                    mean_run: path.mean_run(),
+                    path,
+                }),
+            },
             costs: outcome.costs,
             total_heat_t1: outcome.total_heat_t1,
             total_heat_end: outcome.total_heat_end,
         }
     }
+}
+
+/// The roles in `tdex extrapolate --json`: the pairing's summary in its declared key order
+/// (as before several recorded periods), or the path with its jumps counted.
+#[derive(Debug, Serialize)]
+enum RolesReport {
+    #[serde(rename = "pairing")]
+    Pairing(PairingSummary),
+    #[serde(rename = "path")]
+    Path(PathReport),
+}
+
+/// `path` in `tdex extrapolate --json` (keys in docs/user-guide.md).
+#[derive(Debug, Serialize)]
+struct PathReport {
+    #[serde(flatten)]
+    path: RecurrencePath,
+    jumps: usize,
+    /// Mean periods replayed between two pairings.
+    mean_run: f64,
+}
+
+/// A recurrence path in plain words: the periods used, the jumps and the runs between them.
+pub fn path_words(path: &RecurrencePath) -> String {
+    let k = path.replayed.len();
+    format!(
+        "recorded periods 1 to {} (seed {}): {} jump{} in {k} period{}, {} periods between \
+         jumps on average",
+        path.recorded_periods,
+        path.seed,
+        path.jumps(),
+        if path.jumps() == 1 { "" } else { "s" },
+        if k == 1 { "" } else { "s" },
+        crate::fmt::sig(path.mean_run(), 3)
+    )
+}
+
+/// A pairing of a path in plain words: its snapshots and mean distance.
+pub fn path_pairing_words(p: &tdex_format::extrapolation::PathPairing) -> String {
+    format!(
+        "t{} to t{}: mean distance {} diameters, {}",
+        p.end,
+        p.start,
+        crate::fmt::sig(p.summary.mean_distance_diameters, 4),
+        if p.summary.certified {
+            "certified"
+        } else {
+            "not certified"
+        }
+    )
 }
 
 pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
@@ -61,6 +121,8 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         },
         memory_limit: memory_limit(plan.max_memory),
         reproducible: plan.reproducible,
+        recorded_periods: plan.recorded_periods,
+        path_seed: plan.seed,
     };
     let outcome = crate::with_workers(plan.threads, || {
         extrapolate::extrapolate_recording(&request, tell).map_err(advice)
@@ -103,6 +165,10 @@ pub fn advice(e: ExtrapolateError) -> anyhow::Error {
                 }
             };
             anyhow::Error::new(error).context(format!("{}: {advice}", recording.display()))
+        }
+        ExtrapolateError::RecordedPeriods { recorded, .. } => {
+            let advice = format!("give --recorded-periods between 1 and {recorded}");
+            anyhow::Error::new(e).context(advice)
         }
         e => e.into(),
     }
@@ -230,17 +296,35 @@ pub fn print(
             report.rows,
             crate::fmt::sig(report.max_cfl, 4)
         );
-        println!(
-            "pairing       mean distance {} diameters, {} ({:.2} s{})",
-            crate::fmt::sig(report.pairing.mean_distance_diameters, 4),
-            if report.pairing.certified {
-                "certified"
-            } else {
-                "not certified"
-            },
-            c.seconds_pairing,
-            if c.pairing_reused { ", reused" } else { "" }
-        );
+        let reused = if c.pairing_reused { ", reused" } else { "" };
+        match &report.roles {
+            RolesReport::Pairing(pairing) => println!(
+                "pairing       mean distance {} diameters, {} ({:.2} s{reused})",
+                crate::fmt::sig(pairing.mean_distance_diameters, 4),
+                if pairing.certified {
+                    "certified"
+                } else {
+                    "not certified"
+                },
+                c.seconds_pairing,
+            ),
+            RolesReport::Path(PathReport { path, .. }) => {
+                println!("path          {}", path_words(path));
+                if path.pairings.is_empty() {
+                    println!("pairings      none: the path stayed inside the recording");
+                }
+                for p in &path.pairings {
+                    println!("pairing       {}", path_pairing_words(p));
+                }
+                if !path.pairings.is_empty() {
+                    println!(
+                        "pairings      {} computed or reused in {:.2} s{reused}",
+                        path.pairings.len(),
+                        c.seconds_pairing
+                    );
+                }
+            }
+        }
         println!(
             "replay        {:.3} s per period, {:.3e} rows/s (table read {:.2} s, {})",
             c.seconds_per_period,

@@ -557,7 +557,10 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         scheme: info.scheme.name().into(),
         periods: info.periods,
         // keys in the order the file holds them (sorted)
-        pairing: serde_json::to_value(&info.pairing)?,
+        pairing: match &info.roles {
+            tdex_format::extrapolation::Roles::Pairing(p) => serde_json::to_value(p)?,
+            tdex_format::extrapolation::Roles::Path(path) => serde_json::to_value(path)?,
+        },
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,

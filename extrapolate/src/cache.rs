@@ -1,6 +1,7 @@
-//! The pairing cache: the pairing of a recording's `t0` and `t1` snapshots, computed once and
-//! stored beside the recording ([`sidecar`]), reused while the snapshots'
-//! positions are the ones it was computed for.
+//! The pairing cache: the pairing of two of a recording's snapshots (`t1` to `t0`, or for
+//! several recorded periods `tP` to the start of each period), computed once and stored
+//! beside the recording ([`sidecar`], one file per pair of snapshots), reused while the
+//! snapshots' positions are the ones it was computed for.
 
 use crate::pairing::{self, PairingOptions};
 use crate::sidecar::{self, PairingSummary, StoredPairing};
@@ -9,19 +10,14 @@ use std::hash::Hasher;
 use std::path::PathBuf;
 use tdex_format::{RecordingReader, Snapshot};
 
-/// The snapshots at `t0` and `t1` that bound the recorded period.
-pub fn period_snapshots(
-    reader: &RecordingReader,
-) -> Result<(Snapshot, Snapshot), ExtrapolateError> {
-    let snapshot = |index| {
-        reader
-            .snapshot(index)?
-            .ok_or(ExtrapolateError::MissingSnapshot { index })
-    };
-    Ok((snapshot(0)?, snapshot(1)?))
+/// The recording's snapshot `t_index`.
+pub fn snapshot(reader: &RecordingReader, index: u32) -> Result<Snapshot, ExtrapolateError> {
+    reader
+        .snapshot(index)?
+        .ok_or(ExtrapolateError::MissingSnapshot { index })
 }
 
-/// A hash of the positions at `t0` and `t1`, the pairing's only input: a stored pairing
+/// A hash of the positions at the start (`t0`) and the end (`t1`) the pairing joins, its only input: a stored pairing
 /// is reused for these snapshots and no others (a recording made again with another case
 /// or seed into the same file name has other positions).
 ///
@@ -42,8 +38,9 @@ pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
     h.finish()
 }
 
-/// Computes the pairing of the recording's snapshots at `t0` and `t1` on the current
-/// worker pool; its summary carries the solve's time and thread count.
+/// Computes the pairing of the snapshot `t1` (the end of a period) to `t0` (the start of
+/// one) on the current worker pool: `g[p]` is the role at `t0` nearest particle `p` at
+/// `t1`. Its summary carries the solve's time and thread count.
 pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, ExtrapolateError> {
     let d = t0.mean_diameter();
     let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
@@ -64,21 +61,25 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, Extrapolat
     })
 }
 
-/// The stored pairing of this recording's snapshots `t0` and `t1`, if one matches them (a
-/// missing, unreadable or malformed sidecar is computed again).
+/// The stored pairing of this recording's snapshot `t1` (end) to `t0` (start), if one
+/// matches them (a missing, unreadable or malformed sidecar is computed again). The
+/// snapshots' indices name the sidecar ([`sidecar::path_between`]).
 pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<StoredPairing> {
     let n = reader.info().particles as usize;
-    let stored = sidecar::read(&sidecar::path_of(reader.path()), n).ok()??;
+    let path = sidecar::path_between(reader.path(), t1.index, t0.index);
+    let stored = sidecar::read(&path, n).ok()??;
     (stored.snapshots_fingerprint == fingerprint(t0, t1)).then_some(stored)
 }
 
-/// Writes the pairing beside the recording (temporary file, fsync, rename); returns the
-/// sidecar's path.
+/// Writes the pairing of snapshot `end` to snapshot `start` beside the recording
+/// (temporary file, fsync, rename); returns the sidecar's path.
 pub fn store(
     reader: &RecordingReader,
+    end: u32,
+    start: u32,
     stored: &StoredPairing,
 ) -> Result<PathBuf, ExtrapolateError> {
-    let path = sidecar::path_of(reader.path());
+    let path = sidecar::path_between(reader.path(), end, start);
     Ok(tdex_format::output::write_atomically(
         &path,
         &serde_json::to_vec(stored)?,

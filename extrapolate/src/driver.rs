@@ -1,16 +1,20 @@
-//! The extrapolation of a recording: the memory plan, the pairing (reused from the cache or
-//! computed and stored), the table read or streamed, K periods replayed and written.
+//! The extrapolation of a recording: the memory plan, the pairings (reused from the cache or
+//! computed and stored), the tables read or streamed, K periods replayed along the path and
+//! written.
 
 use crate::cache;
+use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
-    self, Bodies, Exchange, MemoryNeeds, MemoryPlan, Scheme, SyncScratch, Table, TableMode,
+    self, Bodies, CflRow, Exchange, MemoryNeeds, MemoryPlan, Scheme, SyncScratch, Table, TableMode,
 };
-use crate::sidecar::PairingSummary;
+use crate::sidecar::{PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
 use std::path::PathBuf;
 use std::time::Instant;
+use tdex_format::extrapolation::{PathPairing, RecurrencePath, Roles};
 use tdex_format::{
-    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingReader, FORMAT_VERSION,
+    ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingInfo, RecordingReader,
+    Snapshot, FORMAT_VERSION,
 };
 
 /// What to extrapolate, how far, and into which file.
@@ -28,6 +32,12 @@ pub struct ExtrapolationRequest {
     /// No times or thread counts in the sidecar or the extrapolation: the same inputs give
     /// the same bytes on any thread count.
     pub reproducible: bool,
+    /// Recorded periods used, `P'`: the first `P'` of the recording's `P` (`None`: all).
+    /// `P' = 1` is the paper's method on the first recorded period.
+    pub recorded_periods: Option<u32>,
+    /// Seed of the recurrence path's jumps (`None`: the case's `seed`, else 0). Plays no
+    /// part with one recorded period.
+    pub path_seed: Option<u64>,
 }
 
 /// Where the replay keeps the collision table.
@@ -56,21 +66,29 @@ pub enum Notice<'a> {
 #[derive(Debug, Clone)]
 pub struct ExtrapolationOutcome {
     pub particles: u32,
-    /// Rows of the recorded table replayed each period.
+    /// Rows of the recorded tables used (one period's table for the paper's method).
     pub rows: u64,
-    /// The table's largest CFL number of the explicit scheme (0 for an empty table).
+    /// The tables' largest CFL number of the explicit scheme (0 for empty tables).
     pub max_cfl: f64,
     pub memory: MemoryPlan,
     pub limit: MemoryLimit,
-    /// The pairing used, as computed or as stored.
-    pub pairing: PairingSummary,
+    /// The pairing used (one recorded period) or the path followed, with the pairings as
+    /// computed (with their times) or as stored.
+    pub roles: Roles,
     pub costs: ExtrapolationCosts,
     /// `Σ C T` at `t1` and after the last period (J).
     pub total_heat_t1: f64,
     pub total_heat_end: f64,
 }
 
-/// Pairs (or reuses the stored pairing), replays and writes the extrapolation on the
+/// A pairing the path needs: of the end snapshot `t_P'` to the start of recorded period
+/// `period` (snapshot `t_{period − 1}`).
+struct PathStart {
+    period: u32,
+    stored: StoredPairing,
+}
+
+/// Pairs (or reuses the stored pairings), replays and writes the extrapolation on the
 /// current worker pool; `notice` hears what a caller may want to tell the user.
 pub fn extrapolate_recording(
     request: &ExtrapolationRequest,
@@ -82,18 +100,54 @@ pub fn extrapolate_recording(
     };
     let reader = RecordingReader::open(&request.recording)?;
     let info = reader.info().clone();
-    let (t0, t1) = cache::period_snapshots(&reader)?;
-    let bodies = Bodies::of(&info, &t0);
-    let stored_pairing = cache::load(&reader, &t0, &t1);
+    let used = request.recorded_periods.unwrap_or(info.recorded_periods);
+    if !(1..=info.recorded_periods).contains(&used) {
+        return Err(ExtrapolateError::RecordedPeriods {
+            recording: request.recording.clone(),
+            asked: used,
+            recorded: info.recorded_periods,
+        });
+    }
+    let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
+    let steps = RecurrencePolicy::steps(used, seed, request.periods);
+    // the paper's method pairs t1 to t0 even for no period (as it always has); a path
+    // pairs only the starts it jumps to
+    let starts = if used == 1 {
+        vec![1]
+    } else {
+        path::starts(&steps)
+    };
+    let mut replayed = vec![used == 1; used as usize];
+    for s in &steps {
+        replayed[s.period() as usize - 1] = true;
+    }
+    // t0 … t_P': the starts of the periods and the ends whose positions the output carries
+    let mut snaps = (0..=used)
+        .map(|index| cache::snapshot(&reader, index))
+        .collect::<Result<Vec<Snapshot>, _>>()?;
+    let bodies = Bodies::of(&info, &snaps[0]);
+    let end = &snaps[used as usize];
+    let mut stored: Vec<(u32, Option<StoredPairing>)> = starts
+        .iter()
+        .map(|&m| (m, cache::load(&reader, &snaps[m as usize - 1], end)))
+        .collect();
 
     // the memory it will need, stated and held against the limit before the pairing and
     // the replay start: a table that does not fit is streamed, never left to the OOM killer
     let limit = request.memory_limit.clone();
+    let mut rows_of: Vec<u64> = (1..=used).map(|p| period_rows(&reader, p)).collect();
     let needs = MemoryNeeds::estimate(
         info.particles as u64,
-        reader.table_rows(),
+        rows_of
+            .iter()
+            .zip(&replayed)
+            .filter(|(_, &r)| r)
+            .map(|(rows, _)| rows)
+            .sum(),
         reader.largest_table_chunk(),
-        stored_pairing.is_some(),
+        stored.iter().all(|(_, s)| s.is_some()),
+        used,
+        starts.len(),
     );
     let memory = MemoryPlan::choose(
         needs,
@@ -107,44 +161,98 @@ pub fn extrapolate_recording(
         limit: &limit,
     });
 
-    let started = Instant::now();
-    let (stored, reused) = match stored_pairing {
-        Some(stored) => (stored, true),
-        None => {
-            let mut stored = cache::compute(&t0, &t1)?;
-            if request.reproducible {
-                stored.summary = stored.summary.reproducible();
+    // each pairing the path needs, reused or computed once (and stored for the next run)
+    let mut seconds_pairing = 0.0;
+    let mut reused = true;
+    let mut pairings = Vec::with_capacity(stored.len());
+    for (period, found) in stored.drain(..) {
+        let stored = match found {
+            Some(stored) => stored,
+            None => {
+                reused = false;
+                let started = Instant::now();
+                let (start, end) = (&snaps[period as usize - 1], &snaps[used as usize]);
+                let mut stored = cache::compute(start, end)?;
+                if request.reproducible {
+                    stored.summary = stored.summary.reproducible();
+                }
+                // the stored pairing only saves time next run: a recording on a full or
+                // read-only disk is still extrapolated
+                if let Err(e) = cache::store(&reader, end.index, start.index, &stored) {
+                    notice(Notice::PairingNotStored(&e));
+                }
+                seconds_pairing += started.elapsed().as_secs_f64();
+                stored
             }
-            // the stored pairing only saves time next run: a recording on a full or read-only
-            // disk is still extrapolated
-            if let Err(e) = cache::store(&reader, &stored) {
-                notice(Notice::PairingNotStored(&e));
-            }
-            (stored, false)
-        }
-    };
-    let seconds_pairing = if reused {
-        0.0
-    } else {
-        started.elapsed().as_secs_f64()
+        };
+        pairings.push(PathStart { period, stored });
+    }
+    let pairing_of = |period: u32| {
+        pairings
+            .iter()
+            .find(|p| p.period == period)
+            .map(|p| &p.stored.g[..])
+            .expect("a pairing for every start of the path")
     };
 
-    // the table: decoded once into memory, or streamed from the file each period
+    // the tables: decoded once into memory, or streamed from the file each period
     let t = Instant::now();
-    let (table, rows, worst) = if memory.mode == TableMode::Streamed {
-        let found = replay::scan(&reader, &bodies, |_, _| {})?;
-        (None, found.rows, found.worst)
-    } else {
-        let (table, worst) = Table::read(&reader, &bodies)?;
-        let rows = table.exchanges.len() as u64;
-        (Some(table), rows, worst)
-    };
+    let mut tables: Vec<Option<Table>> = vec![None; used as usize];
+    let mut worst: Option<CflRow> = None;
+    for p in (1..=used).filter(|&p| replayed[p as usize - 1]) {
+        let at = p as usize - 1;
+        // the rows as decoded (the summary's counts only sized the estimate)
+        let found = if memory.mode == TableMode::Streamed {
+            let found = replay::scan_period(&reader, &bodies, p, |_, _| {})?;
+            rows_of[at] = found.rows;
+            found.worst
+        } else {
+            let (table, found) = Table::read_period(&reader, &bodies, p, rows_of[at])?;
+            rows_of[at] = table.exchanges.len() as u64;
+            tables[at] = Some(table);
+            found
+        };
+        if found.is_some_and(|f| worst.is_none_or(|w| f.cfl > w.cfl)) {
+            worst = found;
+        }
+    }
+    let rows: u64 = (1..=used)
+        .filter(|&p| replayed[p as usize - 1])
+        .map(|p| rows_of[p as usize - 1])
+        .sum();
     let seconds_read_table = t.elapsed().as_secs_f64();
     let max_cfl = worst.map_or(0.0, |w| w.cfl);
     if let Some(w) = worst.filter(|w| request.scheme == Scheme::Explicit && w.cfl >= 1.0) {
         return Err(refused(w.refusal()));
     }
 
+    let summary_of = |s: &StoredPairing| {
+        if request.reproducible {
+            // a stored pairing made without --reproducible carries its time
+            s.summary.clone().reproducible()
+        } else {
+            s.summary.clone()
+        }
+    };
+    let path_of = |summary: &dyn Fn(&StoredPairing) -> PairingSummary| {
+        if used == 1 {
+            Roles::Pairing(summary(&pairings[0].stored))
+        } else {
+            Roles::Path(RecurrencePath {
+                recorded_periods: used,
+                seed,
+                replayed: steps.iter().map(|s| s.period()).collect(),
+                pairings: pairings
+                    .iter()
+                    .map(|p| PathPairing {
+                        end: used,
+                        start: p.period - 1,
+                        summary: summary(&p.stored),
+                    })
+                    .collect(),
+            })
+        }
+    };
     let out_info = ExtrapolationInfo {
         format_version: FORMAT_VERSION,
         // one version for the whole workspace: the binary's and this library's
@@ -153,33 +261,38 @@ pub fn extrapolate_recording(
         recording_info: info.clone(),
         scheme: request.scheme,
         periods: request.periods,
-        pairing: if request.reproducible {
-            // a stored pairing made without --reproducible carries its time
-            stored.summary.clone().reproducible()
-        } else {
-            stored.summary.clone()
-        },
+        roles: path_of(&summary_of),
     };
     let mut writer = ExtrapolationWriter::create(&request.output, &out_info)?;
-    writer.write_snapshot(&t1)?;
+    writer.write_snapshot(&snaps[1])?;
 
-    // role a ends each period at x_a(t1): the snapshot's positions, radii and velocities
-    let mut temps = t1.temp.clone();
+    // role a ends recorded period p at x_a(t_p): the snapshot's positions, radii and
+    // velocities
+    let mut temps = snaps[1].temp.clone();
     let heat_t1 = replay::total_heat(&temps, &bodies);
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
     let mut exchanges: Vec<Exchange> = Vec::new();
-    // the output snapshot: t1's positions, radii and velocities, the extrapolated
-    // temperatures, and as `id` the particle that plays each role (it moves with its heat)
-    let mut out = t1;
+    // the output snapshot: t_p's positions, radii and velocities, the extrapolated
+    // temperatures, and as `id` the particle that plays each role (it moves with its heat,
+    // at the jumps only)
+    let mut out = if used == 1 {
+        snaps.pop().expect("t0 and t1")
+    } else {
+        snaps[1].clone()
+    };
     let mut next_id = Vec::with_capacity(out.id.len());
     let t = Instant::now();
-    for k in 1..=request.periods {
-        replay::move_to_roles(&temps, &stored.g, &mut next)?;
-        std::mem::swap(&mut temps, &mut next);
-        replay::move_to_roles(&out.id, &stored.g, &mut next_id)?;
-        std::mem::swap(&mut out.id, &mut next_id);
-        match &table {
+    for (k, step) in (1..=request.periods).zip(&steps) {
+        let p = step.period();
+        if let Step::Jump { period } = *step {
+            let g = pairing_of(period);
+            replay::move_to_roles(&temps, g, &mut next)?;
+            std::mem::swap(&mut temps, &mut next);
+            replay::move_to_roles(&out.id, g, &mut next_id)?;
+            std::mem::swap(&mut out.id, &mut next_id);
+        }
+        match &tables[p as usize - 1] {
             Some(table) => replay::apply_rows_with(
                 &mut temps,
                 &table.exchanges,
@@ -188,9 +301,15 @@ pub fn extrapolate_recording(
                 &mut scratch,
             ),
             None => {
-                for batch in reader.table() {
+                let (batches, offset) = replay::period_batches(&reader, p);
+                for batch in batches {
                     exchanges.clear();
-                    exchanges.extend(batch?.rows.iter().map(|r| Exchange::of(r, &info)));
+                    exchanges.extend(
+                        batch?
+                            .rows
+                            .iter()
+                            .map(|r| Exchange::in_period(r, &info, offset)),
+                    );
                     replay::apply_rows_with(
                         &mut temps,
                         &exchanges,
@@ -202,19 +321,30 @@ pub fn extrapolate_recording(
             }
         }
         scratch.flush(&mut temps);
+        if used > 1 {
+            let end = &snaps[p as usize];
+            out.pos.copy_from_slice(&end.pos);
+            out.radius.copy_from_slice(&end.radius);
+            out.vel.copy_from_slice(&end.vel);
+        }
         out.index = k + 1;
         out.time = info.snapshot_time(k + 1);
         out.temp.copy_from_slice(&temps);
         writer.write_snapshot(&out)?;
     }
     let seconds_replay = t.elapsed().as_secs_f64();
+    let rows_replayed: u64 = if used == 1 {
+        rows * u64::from(request.periods)
+    } else {
+        steps.iter().map(|s| rows_of[s.period() as usize - 1]).sum()
+    };
     let costs = ExtrapolationCosts {
         seconds_pairing,
         pairing_reused: reused,
         seconds_read_table,
         seconds_replay,
         seconds_per_period: seconds_replay / request.periods as f64,
-        rows_per_second: rows as f64 * request.periods as f64 / seconds_replay.max(1e-12),
+        rows_per_second: rows_replayed as f64 / seconds_replay.max(1e-12),
         rows,
     };
     writer.finish((!request.reproducible).then_some(&costs))?;
@@ -224,11 +354,33 @@ pub fn extrapolate_recording(
         max_cfl,
         memory,
         limit,
-        pairing: stored.summary,
+        roles: path_of(&|s: &StoredPairing| s.summary.clone()),
         costs,
         total_heat_t1: heat_t1,
         total_heat_end: replay::total_heat(&temps, &bodies),
     })
+}
+
+/// The case's `seed` (the default seed of the path's jumps), 0 if the recording has none
+/// (an imported run).
+fn case_seed(info: &RecordingInfo) -> u64 {
+    info.case_resolved
+        .get("seed")
+        .and_then(serde_json::Value::as_u64)
+        .unwrap_or(0)
+}
+
+/// Rows of recorded period `period` (1-based): the whole table for a recording of one
+/// period, else the summary's count (the whole table, an upper bound, if the summary is
+/// missing).
+fn period_rows(reader: &RecordingReader, period: u32) -> u64 {
+    if reader.info().recorded_periods == 1 {
+        return reader.table_rows();
+    }
+    reader
+        .summary()
+        .and_then(|s| s.period_rows.get(period as usize - 1).copied())
+        .unwrap_or_else(|| reader.table_rows())
 }
 
 /// The memory an extrapolation may use, and where that figure came from.

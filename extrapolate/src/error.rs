@@ -24,6 +24,17 @@ pub enum ExtrapolateError {
         #[source]
         error: ReplayError,
     },
+    /// More recorded periods asked for than the recording holds (or none).
+    #[error(
+        "{}: {asked} recorded periods asked for, but the recording holds {recorded} \
+         (recorded_periods must be between 1 and {recorded})",
+        recording.display()
+    )]
+    RecordedPeriods {
+        recording: PathBuf,
+        asked: u32,
+        recorded: u32,
+    },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -39,7 +50,8 @@ impl Classify for ExtrapolateError {
             ExtrapolateError::Format(e) => e.fault(),
             ExtrapolateError::Pairing(_)
             | ExtrapolateError::Replay(_)
-            | ExtrapolateError::Refused { .. } => Fault::Input,
+            | ExtrapolateError::Refused { .. }
+            | ExtrapolateError::RecordedPeriods { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)

@@ -1,5 +1,6 @@
 //! Pairing of the t0/t1 snapshots and replay of a recorded collision table (docs/method.md §5–6;
 //! issue 4): [`pairing`] finds the roles, [`replay`] applies the table period after period,
+//! [`path`] chooses the recorded period each period replays (several recorded periods),
 //! [`sidecar`] stores the pairing beside the recording and [`cache`] reuses it;
 //! [`extrapolate_recording`] extrapolates a recording with them.
 
@@ -7,6 +8,7 @@ pub mod cache;
 mod driver;
 mod error;
 pub mod pairing;
+pub mod path;
 pub mod replay;
 
 pub use driver::{

@@ -187,6 +187,14 @@ pub struct ExtrapolateArgs {
     /// same recording and flags then give the same file byte for byte.
     #[arg(long)]
     pub reproducible: bool,
+    /// Recorded periods to use, P': the first P' of a recording made with
+    /// --recorded-periods P (default: all P). 1 is the paper's method on the first period.
+    #[arg(long = "recorded-periods", value_name = "P", value_parser = periods_used())]
+    pub recorded_periods: Option<u32>,
+    /// Seed of the recurrence path's jumps through several recorded periods (default: the
+    /// case's seed). The same seed gives the same path and the same bytes.
+    #[arg(long)]
+    pub seed: Option<u64>,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
@@ -568,6 +576,11 @@ fn threads() -> super::values::Count<usize> {
 /// `--periods` to extrapolate: at least one.
 fn periods() -> super::values::Count<u32> {
     count(1, "a whole number", "extrapolate at least 1 period")
+}
+
+/// `tdex extrapolate --recorded-periods`: at least one.
+fn periods_used() -> super::values::Count<u32> {
+    count(1, "a whole number", "use at least 1 recorded period")
 }
 
 /// `--cells`: at least one Voronoi cell.

@@ -146,6 +146,10 @@ pub struct ExtrapolatePlan {
     pub max_memory: Option<u64>,
     pub threads: usize,
     pub reproducible: bool,
+    /// `--recorded-periods P'`: the first P' recorded periods (`None`: all).
+    pub recorded_periods: Option<u32>,
+    /// `--seed`: the recurrence path's seed (`None`: the case's).
+    pub seed: Option<u64>,
     pub json: bool,
 }
 
@@ -363,6 +367,8 @@ impl ExtrapolatePlan {
             max_memory: args.max_memory,
             threads: workers(args.threads),
             reproducible: args.reproducible,
+            recorded_periods: args.recorded_periods,
+            seed: args.seed,
             json: args.json,
         })
     }

@@ -370,9 +370,11 @@ pub fn compare_runs(
         (None, None) => ContrastKind::None,
     };
 
-    // The extrapolated positions are the roles' positions at t1: one cell assignment; a
-    // second DEM run moves, so each of its snapshots is assigned anew.
-    let mut role_cells: Option<Vec<u32>> = None;
+    // The extrapolated positions are the roles' positions at the end of the recorded period
+    // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
+    // a recurrence path (assigned anew when they change); a second DEM run moves, so each of
+    // its snapshots is assigned anew.
+    let mut role_cells: Option<(Vec<[f64; 3]>, Vec<u32>)> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
     let mut previous: Option<Snapshot> = None;
@@ -391,7 +393,10 @@ pub fn compare_runs(
         let moved;
         let extra_cells: &[u32] = match kind {
             SecondKind::Extrapolation => {
-                role_cells.get_or_insert_with(|| cells_v.assign(&after.pos))
+                if role_cells.as_ref().is_none_or(|(pos, _)| *pos != after.pos) {
+                    role_cells = Some((after.pos.clone(), cells_v.assign(&after.pos)));
+                }
+                &role_cells.as_ref().expect("assigned just above").1
             }
             SecondKind::Dem => {
                 moved = cells_v.assign(&after.pos);

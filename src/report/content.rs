@@ -7,6 +7,7 @@ use super::document::{bold, code, link, para, text, Block, Document};
 use super::prediction::{Point, Prediction};
 use crate::compare::{Comparison, ContrastKind, PeriodComparison};
 use crate::fmt::trim_zeros;
+use tdex_format::extrapolation::Roles;
 use tdex_format::{ExtrapolationInfo, RecordingInfo, RecordingSummary};
 
 /// Columns of the error table before it continues in a second table.
@@ -287,18 +288,32 @@ pub fn document(inp: &Inputs) -> Document {
             "none".into()
         }
     };
-    let pairing = &inp.extrapolation.pairing;
-    let pairing_text = {
-        let mean = Some(pairing.mean_distance_diameters);
-        let certified = Some(pairing.certified);
-        let seconds = pairing.seconds;
-        format!(
-            "mean distance {} diameters; certified optimal: {}; computed in {} s",
-            opt(mean, |m| sig(m, 4)),
-            certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
-            opt(seconds, secs),
-        )
-    };
+    let pairing_row =
+        match &inp.extrapolation.roles {
+            Roles::Pairing(pairing) => {
+                let mean = Some(pairing.mean_distance_diameters);
+                let certified = Some(pairing.certified);
+                let seconds = pairing.seconds;
+                row(
+                    "Pairing of t0 and t1",
+                    format!(
+                        "mean distance {} diameters; certified optimal: {}; computed in {} s",
+                        opt(mean, |m| sig(m, 4)),
+                        certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
+                        opt(seconds, secs),
+                    ),
+                )
+            }
+            Roles::Path(path) => row(
+                "Recurrence path",
+                std::iter::once(crate::extrapolation::path_words(path))
+                    .chain(path.pairings.iter().map(|p| {
+                        format!("pairing {}", crate::extrapolation::path_pairing_words(p))
+                    }))
+                    .collect::<Vec<_>>()
+                    .join("; "),
+            ),
+        };
     let groups = if p.hot_particles + p.cold_particles > 0 {
         format!(
             "{} ({} initially hot, {} initially cold)",
@@ -378,7 +393,7 @@ pub fn document(inp: &Inputs) -> Document {
                 "Extrapolated periods",
                 format!("{periods} ({})", span(periods + 1)),
             ),
-            row("Pairing of t0 and t1", pairing_text),
+            pairing_row,
         ]
         .into_iter()
         .chain(c.map(|c| row("Voronoi cells", format!("{} (seed {})", c.cells, c.seed))))

@@ -157,7 +157,7 @@ pub fn write_with(
 
     let costs = match (recording.costs(), extrapolation.costs()) {
         (Some(rc), Some(ec)) => {
-            let pairing_seconds = extrapolation.info().pairing.seconds;
+            let pairing_seconds = extrapolation.info().roles.pairing_seconds();
             Ok(CostTable::new(
                 rc,
                 info.reference_periods,

@@ -107,6 +107,8 @@ pub fn evaluate(
         table: TableChoice::InMemoryIfItFits,
         memory_limit: extrapolation::memory_limit(None),
         reproducible: false,
+        recorded_periods: None,
+        path_seed: None,
     };
     if let Err(e) = crate::with_workers(threads, || {
         Ok(extrapolate::extrapolate_recording(
@@ -131,7 +133,7 @@ pub fn evaluate(
     let abs: Vec<f64> = o.energy_error.iter().flatten().map(|e| e.abs()).collect();
     o.energy_error_mean_abs = (!abs.is_empty()).then(|| abs.iter().sum::<f64>() / abs.len() as f64);
     if let (Some(rc), Some(ec)) = (rec.costs(), ext.costs()) {
-        let pairing = ext.info().pairing.seconds;
+        let pairing = ext.info().roles.pairing_seconds();
         let table = CostTable::new(rc, rec.info().reference_periods, ec, pairing);
         o.speedup_100 = table.speedup(TABLE_PERIODS as f64);
     }

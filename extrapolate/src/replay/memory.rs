@@ -24,6 +24,15 @@ const POINT_BYTES: u64 = 68;
 /// writer's chunk (or, when read, a decompressed chunk and its message copy): 3 points.
 pub const PARTICLE_BYTES: u64 = 2 * POINT_BYTES + 16 + 8 + 16 + 16 + 8 + 3 * POINT_BYTES;
 
+/// Per particle and per recorded period of a recurrence path (`P' > 1`): the `P' − 1` end
+/// snapshots beyond `t1`, whose positions, radii and velocities the output carries, and the
+/// output's own copy of one (the paper's method writes `t1` itself).
+pub const PERIOD_BYTES: u64 = POINT_BYTES;
+
+/// Per particle and per pairing beyond the first (a recurrence path jumping to several
+/// starts): its `g`, held for the whole replay.
+pub const EXTRA_PAIRING_BYTES: u64 = 4;
+
 /// Candidates per particle the pairing may hold: 24 at first, doubled once when they admit
 /// no perfect matching (`PairingOptions::k_initial`).
 const PAIRING_K: u64 = 48;
@@ -48,7 +57,8 @@ const BATCH_BYTES: u64 =
 pub struct MemoryNeeds {
     pub particles: u64,
     pub rows: u64,
-    /// Per-particle state ([`PARTICLE_BYTES`] each).
+    /// Per-particle state ([`PARTICLE_BYTES`] each, and [`PERIOD_BYTES`] and
+    /// [`EXTRA_PAIRING_BYTES`] for each further recorded period and pairing of a path).
     pub particle_bytes: u64,
     /// Computing the pairing; 0 when a stored pairing is reused.
     pub pairing_bytes: u64,
@@ -61,12 +71,28 @@ pub struct MemoryNeeds {
 
 impl MemoryNeeds {
     /// The needs of replaying `rows` rows over `particles` particles from a recording whose
-    /// largest table chunk is `largest_chunk` bytes uncompressed.
-    pub fn estimate(particles: u64, rows: u64, largest_chunk: u64, pairing_reused: bool) -> Self {
+    /// largest table chunk is `largest_chunk` bytes uncompressed, through `pairings`
+    /// pairings (all stored: `pairing_reused`) and the end snapshots of `recorded_periods`
+    /// periods (1 and 1 for the paper's method).
+    pub fn estimate(
+        particles: u64,
+        rows: u64,
+        largest_chunk: u64,
+        pairing_reused: bool,
+        recorded_periods: u32,
+        pairings: usize,
+    ) -> Self {
+        let per_particle = PARTICLE_BYTES
+            + if recorded_periods > 1 {
+                u64::from(recorded_periods) * PERIOD_BYTES
+            } else {
+                0
+            }
+            + (pairings.saturating_sub(1) as u64) * EXTRA_PAIRING_BYTES;
         Self {
             particles,
             rows,
-            particle_bytes: particles.saturating_mul(PARTICLE_BYTES),
+            particle_bytes: particles.saturating_mul(per_particle),
             pairing_bytes: if pairing_reused {
                 0
             } else {
@@ -193,7 +219,7 @@ mod tests {
     #[test]
     fn a_table_that_fits_stays_in_memory_and_one_that_does_not_is_streamed() {
         // 10 000 particles, 10 million rows (229 MiB of table), 8 MiB chunks
-        let needs = MemoryNeeds::estimate(10_000, 10_000_000, 8 * MIB, false);
+        let needs = MemoryNeeds::estimate(10_000, 10_000_000, 8 * MIB, false, 1, 1);
         assert_eq!(needs.table_bytes, 240_000_000);
         assert!(needs.in_memory() > needs.table_bytes);
         assert!(needs.streamed() < 100 * MIB, "{}", needs.streamed());
@@ -227,7 +253,7 @@ mod tests {
 
     #[test]
     fn a_limit_below_the_streamed_needs_is_refused_with_the_numbers() {
-        let needs = MemoryNeeds::estimate(1_000_000, 5_000_000, 8 * MIB, false);
+        let needs = MemoryNeeds::estimate(1_000_000, 5_000_000, 8 * MIB, false, 1, 1);
         let err = MemoryPlan::choose(needs, needs.streamed() - 1, "--max-memory", false)
             .unwrap_err()
             .to_string();
@@ -240,7 +266,7 @@ mod tests {
             assert!(err.contains(part), "missing '{part}': {err}");
         }
         // a stored pairing lowers the need below the pairing's peak
-        let reused = MemoryNeeds::estimate(1_000_000, 5_000_000, 8 * MIB, true);
+        let reused = MemoryNeeds::estimate(1_000_000, 5_000_000, 8 * MIB, true, 1, 1);
         assert!(reused.streamed() < needs.streamed());
         assert!(MemoryPlan::choose(reused, needs.streamed() - 1, "x", false).is_ok());
     }
@@ -248,8 +274,15 @@ mod tests {
     #[test]
     fn the_figures_add_up_by_layout() {
         assert_eq!(ROW_BYTES, 24);
-        let needs = MemoryNeeds::estimate(1000, 0, 0, true);
+        let needs = MemoryNeeds::estimate(1000, 0, 0, true, 1, 1);
         assert_eq!(needs.particle_bytes, 1000 * PARTICLE_BYTES);
+        // a path through 4 recorded periods holding 3 pairings: t2, t3, t4 and the output's
+        // copy, 2 more g
+        let path = MemoryNeeds::estimate(1000, 0, 0, true, 4, 3);
+        assert_eq!(
+            path.particle_bytes,
+            1000 * (PARTICLE_BYTES + 4 * PERIOD_BYTES + 2 * EXTRA_PAIRING_BYTES)
+        );
         assert_eq!(needs.in_memory(), needs.streamed());
         assert_eq!(human_bytes(512), "512 B");
         assert_eq!(human_bytes(3 << 30), "3.00 GiB");

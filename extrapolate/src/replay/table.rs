@@ -1,7 +1,7 @@
 //! The table in the replay's compact form: each row as its two bodies, its start and the
 //! heat it can carry per kelvin, `H·m` (J/K); 24 bytes a row.
 
-use tdex_format::CollisionRow;
+use tdex_format::{CollisionRow, TableBatch};
 use tdex_format::{FormatError, RecordingInfo, RecordingReader, Snapshot};
 
 /// One row ready to apply.
@@ -61,6 +61,12 @@ impl Bodies {
 impl Exchange {
     /// A decoded row, with the recording's conduction constants.
     pub fn of(row: &CollisionRow, info: &RecordingInfo) -> Self {
+        Self::in_period(row, info, 0)
+    }
+
+    /// [`Exchange::of`] of a row of a recorded period that starts `offset` steps after
+    /// `t0`: its start counted from the period's start.
+    pub fn in_period(row: &CollisionRow, info: &RecordingInfo, offset: u64) -> Self {
         let conductivity = if row.j >= info.particles {
             info.wall_conductivity
         } else {
@@ -69,7 +75,7 @@ impl Exchange {
         Self {
             i: row.i,
             j: row.j,
-            start_step: row.start_step as u32,
+            start_step: row.start_step.wrapping_sub(offset) as u32,
             conductance_time: conductivity * row.sqrt_area * row.duration_steps as f64 * info.dt,
         }
     }
@@ -102,14 +108,60 @@ pub struct TableScan {
 pub fn scan(
     reader: &RecordingReader,
     bodies: &Bodies,
+    each: impl FnMut(&CollisionRow, Exchange),
+) -> Result<TableScan, FormatError> {
+    scan_batches(reader.table(), reader.info(), 0, bodies, each)
+}
+
+/// [`scan`] of the rows of recorded period `period` (1-based) alone, their [`Exchange`]
+/// starts counted from the period's own start (a synchronous group never spans two
+/// periods). The table of a recording of one period is its whole table, read as [`scan`]
+/// reads it.
+pub fn scan_period(
+    reader: &RecordingReader,
+    bodies: &Bodies,
+    period: u32,
+    each: impl FnMut(&CollisionRow, Exchange),
+) -> Result<TableScan, FormatError> {
+    let (batches, offset) = period_batches(reader, period);
+    scan_batches(batches, reader.info(), offset, bodies, each)
+}
+
+/// The batches of recorded period `period` (1-based) and the steps from `t0` to its start:
+/// the whole table of a recording of one period (as [`scan`] reads it), else
+/// [`RecordingReader::period_table`].
+pub fn period_batches(
+    reader: &RecordingReader,
+    period: u32,
+) -> (
+    Box<dyn Iterator<Item = Result<TableBatch, FormatError>> + '_>,
+    u64,
+) {
+    let info = reader.info();
+    if info.recorded_periods == 1 {
+        return (Box::new(reader.table()), 0);
+    }
+    let index = period.saturating_sub(1);
+    (
+        Box::new(reader.period_table(index)),
+        u64::from(index) * info.period_steps,
+    )
+}
+
+/// The rows of `batches` handed to `each`, their starts moved back by `offset` steps, and
+/// the worst CFL row among them.
+fn scan_batches(
+    batches: impl Iterator<Item = Result<TableBatch, FormatError>>,
+    info: &RecordingInfo,
+    offset: u64,
+    bodies: &Bodies,
     mut each: impl FnMut(&CollisionRow, Exchange),
 ) -> Result<TableScan, FormatError> {
-    let info = reader.info();
     let mut found = TableScan::default();
-    for batch in reader.table() {
+    for batch in batches {
         let batch = batch?;
         for (k, r) in batch.rows.iter().enumerate() {
-            let e = Exchange::of(r, info);
+            let e = Exchange::in_period(r, info, offset);
             let cfl = bodies.cfl(&e);
             if found.worst.is_none_or(|w| cfl > w.cfl) {
                 found.worst = Some(CflRow {
@@ -148,6 +200,20 @@ impl Table {
         let mut exchanges = Vec::new();
         let _ = exchanges.try_reserve_exact(usize::try_from(reader.table_rows()).unwrap_or(0));
         let found = scan(reader, bodies, |_, e| exchanges.push(e))?;
+        Ok((Self { exchanges }, found.worst))
+    }
+
+    /// Decodes the rows of recorded period `period` (1-based), `rows` of them
+    /// ([`scan_period`]), with their worst CFL row.
+    pub fn read_period(
+        reader: &RecordingReader,
+        bodies: &Bodies,
+        period: u32,
+        rows: u64,
+    ) -> Result<(Self, Option<CflRow>), FormatError> {
+        let mut exchanges = Vec::new();
+        let _ = exchanges.try_reserve_exact(usize::try_from(rows).unwrap_or(0));
+        let found = scan_period(reader, bodies, period, |_, e| exchanges.push(e))?;
         Ok((Self { exchanges }, found.worst))
     }
 }

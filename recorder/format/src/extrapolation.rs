@@ -27,10 +27,90 @@ pub struct ExtrapolationInfo {
     pub recording_info: RecordingInfo,
     pub scheme: Scheme,
     pub periods: u32,
-    /// The pairing's summary (see `tdex pair --json`). Written with its keys in
+    /// How the roles went from one period to the next: the key `pairing` (one recorded
+    /// period) or the key `path` (several), in place of the one field the files held before
+    /// several recorded periods existed.
+    #[serde(flatten)]
+    pub roles: Roles,
+}
+
+/// How an extrapolation moved the temperatures to their roles at the period boundaries.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum Roles {
+    /// One recorded period replayed through the pairing of `t1` (end) to `t0` (start): the
+    /// paper's method. Its summary (see `tdex pair --json`) is written with its keys in
     /// alphabetical order, as the files have held it since the first version.
-    #[serde(serialize_with = "keys_sorted")]
-    pub pairing: PairingSummary,
+    #[serde(rename = "pairing", serialize_with = "keys_sorted")]
+    Pairing(PairingSummary),
+    /// Several recorded periods replayed along a recurrence path (docs/method.md §6).
+    #[serde(rename = "path")]
+    Path(RecurrencePath),
+}
+
+impl Roles {
+    /// Wall seconds the pairings used took to compute, as stored (`None` when none carries
+    /// a time: a reproducible extrapolation, or a path that needed no pairing).
+    pub fn pairing_seconds(&self) -> Option<f64> {
+        match self {
+            Roles::Pairing(p) => p.seconds,
+            Roles::Path(path) => path
+                .pairings
+                .iter()
+                .filter_map(|p| p.summary.seconds)
+                .reduce(|a, b| a + b),
+        }
+    }
+}
+
+/// The recurrence path an extrapolation of several recorded periods followed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RecurrencePath {
+    /// Recorded periods used, `P'` (the first `P'` of the recording's; at least 2).
+    pub recorded_periods: u32,
+    /// Seed of the jumps' generator (xoshiro256++ seeded with `seed_from_u64`).
+    pub seed: u64,
+    /// The recorded period (1-based) replayed at each extrapolated period `k = 1 … K`.
+    pub replayed: Vec<u32>,
+    /// The pairing of each start the path jumped to, by start: snapshot `t_end` (`end` =
+    /// `P'`) paired to `t_start` (`start` = `m − 1` for a jump to period `m`).
+    pub pairings: Vec<PathPairing>,
+}
+
+impl RecurrencePath {
+    /// Whether each extrapolated period was entered through a pairing (a jump) rather than
+    /// as the recording's own continuation of the period before (`t1` ends period 1).
+    fn entered_by_jump(&self) -> impl Iterator<Item = bool> + '_ {
+        self.replayed.iter().scan(1u32, |previous, &p| {
+            let jump = p != *previous + 1;
+            *previous = p;
+            Some(jump)
+        })
+    }
+
+    /// Jumps made (extrapolated periods entered through a pairing).
+    pub fn jumps(&self) -> usize {
+        self.entered_by_jump().filter(|&jump| jump).count()
+    }
+
+    /// Mean length, in periods, of the stretches replayed without a pairing (each starts
+    /// at `t1` or at a jump); 0 for no period.
+    pub fn mean_run(&self) -> f64 {
+        let stretches = self
+            .entered_by_jump()
+            .enumerate()
+            .filter(|&(k, jump)| jump || k == 0)
+            .count();
+        self.replayed.len() as f64 / stretches.max(1) as f64
+    }
+}
+
+/// One pairing a recurrence path used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PathPairing {
+    /// Snapshot index of the end (`t_end`) and of the start (`t_start`) it pairs.
+    pub end: u32,
+    pub start: u32,
+    pub summary: PairingSummary,
 }
 
 /// Serialises `value` as a JSON object with its keys sorted (serde_json's map without

@@ -1,4 +1,7 @@
-//! The pairing sidecar (`RECORDING.pairing.json`, written by `tdex pair`): its contents and a reader that refuses any file that is not a pairing of the recording's particles.
+//! The pairing sidecars (`RECORDING.pairing.json` and, for several recorded periods,
+//! `RECORDING.pairing.t<end>-t<start>.json`, written by `tdex pair` and `tdex extrapolate`):
+//! their contents and a reader that refuses any file that is not a pairing of the
+//! recording's particles.
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -77,6 +80,18 @@ impl crate::Classify for SidecarError {
 pub fn path_of(recording: &Path) -> PathBuf {
     let mut name = recording.as_os_str().to_owned();
     name.push(".pairing.json");
+    PathBuf::from(name)
+}
+
+/// The sidecar of the pairing of snapshot `t_end` to `t_start` of the recording
+/// `recording`: [`path_of`] for `t1` to `t0` (the only pairing of one recorded period, under
+/// the name it has always had), else the path with `.pairing.t<end>-t<start>.json` appended.
+pub fn path_between(recording: &Path, end: u32, start: u32) -> PathBuf {
+    if (end, start) == (1, 0) {
+        return path_of(recording);
+    }
+    let mut name = recording.as_os_str().to_owned();
+    name.push(format!(".pairing.t{end}-t{start}.json"));
     PathBuf::from(name)
 }
 
@@ -161,6 +176,14 @@ mod tests {
         assert_eq!(
             path_of(Path::new("a/r.mcap")),
             Path::new("a/r.mcap.pairing.json")
+        );
+        assert_eq!(
+            path_between(Path::new("a/r.mcap"), 1, 0),
+            Path::new("a/r.mcap.pairing.json")
+        );
+        assert_eq!(
+            path_between(Path::new("a/r.mcap"), 3, 0),
+            Path::new("a/r.mcap.pairing.t3-t0.json")
         );
     }
 }

@@ -95,15 +95,15 @@ pub fn decode(bytes: &[u8], info: &RecordingInfo) -> Result<TableBatch, String> 
                 row.duration_steps, info.dtc_max_steps
             ));
         }
-        // a row ends by the end of its recorded period: rows are cut at the boundaries
+        // a row ends inside the recorded period it starts in (rows are cut at the period
+        // boundaries), and that period is one of the recording's
         let period = info.period_of_step(row.start_step);
         let period_end = (period + 1).checked_mul(info.period_steps);
         let end = row.start_step.checked_add(row.duration_steps as u64);
-        let beyond = match (end, period_end) {
-            (Some(end), Some(period_end)) => end > period_end,
-            _ => true,
-        };
-        if period >= info.recorded_periods as u64 || beyond || row.start_step < previous_start {
+        if period >= info.recorded_periods as u64
+            || end.zip(period_end).is_none_or(|(end, limit)| end > limit)
+            || row.start_step < previous_start
+        {
             return bad(format!(
                 "start step {} (duration {}) out of apparition order or beyond its recorded period ({} of {} steps)",
                 row.start_step, row.duration_steps, info.recorded_periods, info.period_steps
