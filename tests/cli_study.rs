@@ -322,3 +322,84 @@ fn bad_study_flags_exit_2_naming_the_flag() {
         "no work before the flags are checked"
     );
 }
+
+/// The horizon study on the tiny drum: one DEM run recording two periods with a twin, both
+/// P replayed over the same reference periods and judged against the same DEM runs; the
+/// recording cost grows with P; the same study from the recording itself gives the same
+/// verdicts; flags that shape a recording are refused with a recording.
+#[test]
+fn horizon_study_compares_recorded_periods_on_one_dem_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path());
+    let out = dir.path().join("horizon");
+    let json = ok(&[
+        "study",
+        "horizon",
+        case.to_str().unwrap(),
+        "--recorded-periods",
+        "2,1",
+        "--reference",
+        "3",
+        "--twins",
+        "1",
+        "--tau-rev",
+        "0.05",
+        "--threads",
+        "2",
+        "--json",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let study: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let runs = study["runs"].as_array().unwrap();
+    let p: Vec<u64> = runs
+        .iter()
+        .map(|r| r["recorded_periods"].as_u64().unwrap())
+        .collect();
+    assert_eq!(p, [1, 2], "distinct and ascending");
+    assert_eq!(study["periods_in_recording"], 2);
+    for r in runs {
+        // t2..t4 judged against the DEM and its twin
+        assert_eq!(r["compared"], 3, "{r}");
+        assert!(r["median_ratio"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["verdict"].as_str().unwrap().len() > 20, "{r}");
+    }
+    let cost = |r: &serde_json::Value| r["recording_seconds"].as_f64().unwrap();
+    assert!(cost(&runs[1]) > cost(&runs[0]), "{json}");
+    for f in ["study.json", "study.md", "ratio.svg", "means.svg", "horizon.mcap"] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+
+    // from the recording: the same DEM runs, the same paths, the same judgement
+    let rec = out.join("horizon.mcap");
+    let again = dir.path().join("again");
+    let json2 = ok(&[
+        "study",
+        "horizon",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "1,2",
+        "--json",
+        "-o",
+        again.to_str().unwrap(),
+    ]);
+    let study2: serde_json::Value = serde_json::from_str(&json2).unwrap();
+    for (a, b) in runs.iter().zip(study2["runs"].as_array().unwrap()) {
+        assert_eq!(a["median_ratio"], b["median_ratio"]);
+        assert_eq!(a["outside_range"], b["outside_range"]);
+    }
+
+    // a recording has its own reference periods; it cannot replay more periods than it holds
+    for (flags, expect) in [
+        (vec!["--reference", "5"], "--reference: "),
+        (vec!["--recorded-periods", "3"], "holds 2 recorded period(s)"),
+    ] {
+        let mut args = vec!["study", "horizon", rec.to_str().unwrap()];
+        args.extend(flags);
+        args.extend(["-o", again.to_str().unwrap()]);
+        let o = run_tdex(&args);
+        assert_eq!(o.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(expect), "{err}");
+    }
+}

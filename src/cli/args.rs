@@ -460,6 +460,12 @@ pub enum StudyCommand {
     /// regime (Mellmann 2001), the dynamic angle of repose, the active-layer thickness and
     /// (where particles move relative to the drum) the extrapolation error and speedup.
     Regimes(RegimesStudyArgs),
+    /// Long-horizon study (issue 23): per number of recorded periods P, the extrapolation
+    /// over the reference periods against the DEM and its twins (median ratio to their
+    /// spread, the t_k outside their range) beside what recording P periods costs. CASE may
+    /// also be a recording made with `tdex record --recorded-periods P --reference K --twins M`
+    /// (for long DEM runs: record it in the background with `--checkpoint-every`).
+    Horizon(HorizonStudyArgs),
 }
 
 /// `tdex study sampling`.
@@ -522,6 +528,37 @@ pub struct PeriodStudyArgs {
     pub revolutions: f64,
     #[command(flatten)]
     pub sampling: SamplingFlags,
+}
+
+/// `tdex study horizon`.
+#[derive(Debug, clap::Args)]
+pub struct HorizonStudyArgs {
+    #[command(flatten)]
+    pub common: StudyCommon,
+    /// Numbers of recorded periods P to compare, comma-separated. The DEM runs once and
+    /// records the largest; a smaller P replays the first P of its periods (the tables and
+    /// snapshots a recording of P periods holds).
+    #[arg(
+        long = "recorded-periods",
+        value_delimiter = ',',
+        default_value = "1,2,4",
+        value_parser = clap::value_parser!(u32).range(1..=tdex_format::MAX_RECORDED_PERIODS as i64)
+    )]
+    pub recorded_periods: Vec<u32>,
+    /// Reference periods K after t1: the DEM, its twins and every extrapolation run to
+    /// t_{K+1} [default: 25]. Given a recording, its own.
+    #[arg(long, value_parser = periods())]
+    pub reference: Option<u32>,
+    /// DEM twins, the yardstick: the extrapolation is judged against their spread
+    /// [default: 2]. Given a recording, its own.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=tdex_format::MAX_TWINS as i64))]
+    pub twins: Option<u32>,
+    /// Period τ as a fraction of a drum revolution [default: 1]. Given a recording, its own.
+    #[arg(long = "tau-rev", allow_negative_numbers = true, value_parser = tau_rev())]
+    pub tau_rev: Option<f64>,
+    /// Seed of the recurrence paths (default: the case's seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
 }
 
 /// `tdex study regimes`.

@@ -8,7 +8,7 @@ pub use args::Cli;
 pub use args::SamplingFlags;
 pub(crate) use plan::record_options;
 pub use plan::{
-    BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExportVtkPlan, ExtrapolatePlan, ImportPlan,
-    InspectPlan, PairPlan, Plan, RecordPlan, RecordStart, RegimeRun, ReportPlan, RunPlan,
-    StudyKind, StudyPlan, Tau, UsageError,
+    BenchPlan, BenchRecordPlan, ComparePlan, DemoPlan, ExportVtkPlan, ExtrapolatePlan,
+    HorizonSource, ImportPlan, InspectPlan, PairPlan, Plan, RecordPlan, RecordStart, RegimeRun,
+    ReportPlan, RunPlan, StudyKind, StudyPlan, Tau, UsageError,
 };

@@ -3,16 +3,16 @@
 
 use super::args::{
     BenchArgs, BenchCommand, BenchRecordArgs, Cli, Command, CompareArgs, DemoArgs, ExportCommand,
-    ExtrapolateArgs, ImportCommand, InspectArgs, LiggghtsArgs, PairArgs, PeriodStudyArgs,
-    RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs, SamplingFlags,
-    SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
+    ExtrapolateArgs, HorizonStudyArgs, ImportCommand, InspectArgs, LiggghtsArgs, PairArgs,
+    PeriodStudyArgs, RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs,
+    SamplingFlags, SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
 };
 use anyhow::Result;
 use extrapolate::replay::Scheme;
 use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
-use tdex_format::AreaEncoding;
+use tdex_format::{AreaEncoding, RecordingReader};
 
 /// Flags that do not fit the case or each other, or outputs that cannot be written
 /// (exit code 2). A CLI type: the libraries and analysis modules report bad input with their
@@ -75,6 +75,27 @@ pub struct StudyPlan {
     pub kind: StudyKind,
 }
 
+/// Where the horizon study's recording comes from.
+pub enum HorizonSource {
+    /// Record the case once, with the largest number of recorded periods asked for.
+    Record(RecordOptions),
+    /// A recording made before (its own periods, reference and twins).
+    Recording(PathBuf),
+}
+
+/// `tdex study horizon`'s defaults for a case: 25 reference periods, 2 twins.
+const DEFAULT_HORIZON_REFERENCE: u32 = 25;
+const DEFAULT_HORIZON_TWINS: u32 = 2;
+
+/// Whether `path` starts with the MCAP magic bytes (a recording) rather than a case's TOML.
+fn is_recording(path: &std::path::Path) -> bool {
+    use std::io::Read;
+    let mut magic = [0u8; 8];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut magic))
+        .is_ok_and(|()| &magic == b"\x89MCAP0\r\n")
+}
+
 pub enum StudyKind {
     /// One DEM run, one recording per `(n, Δt_c^max)` in `runs`.
     Sampling {
@@ -87,6 +108,15 @@ pub enum StudyKind {
     Period {
         runs: Vec<(f64, RecordOptions)>,
         revolutions: f64,
+    },
+    /// One recording (made or read) replayed with each number of recorded periods over its
+    /// reference periods.
+    Horizon {
+        source: HorizonSource,
+        /// Distinct, ascending.
+        recorded_periods: Vec<u32>,
+        /// The recurrence paths' seed; `None`: the case's.
+        seed: Option<u64>,
     },
     /// One recording per drum speed (the case with its rotation period replaced).
     Regimes {
@@ -628,6 +658,7 @@ impl StudyCommand {
             StudyCommand::Sampling(args) => &args.common,
             StudyCommand::Period(args) => &args.common,
             StudyCommand::Regimes(args) => &args.common,
+            StudyCommand::Horizon(args) => &args.common,
         }
     }
 
@@ -637,6 +668,7 @@ impl StudyCommand {
             StudyCommand::Sampling(_) => "sampling",
             StudyCommand::Period(_) => "period",
             StudyCommand::Regimes(_) => "regimes",
+            StudyCommand::Horizon(_) => "horizon",
         }
     }
 }
@@ -649,14 +681,33 @@ impl StudyPlan {
             .clone()
             .unwrap_or_else(|| PathBuf::from(format!("tdex-study-{}", study.name())));
         check_output_dir(&output)?;
-        let (case, case_toml) = recorder::case::load_with_text(&common.case)?;
+        let recording = match &study {
+            StudyCommand::Horizon(_) if is_recording(&common.case) => {
+                Some(RecordingReader::open(&common.case)?)
+            }
+            _ => None,
+        };
+        // a recording carries its case: the study is of that case
+        let (case_path, (case, case_toml)) = match &recording {
+            Some(r) => {
+                let path = PathBuf::from(&r.info().case_path);
+                let text = r.info().case_toml.clone();
+                let case = recorder::case::parse(&text, &path)?;
+                (path, (case, text))
+            }
+            None => (
+                common.case.clone(),
+                recorder::case::load_with_text(&common.case)?,
+            ),
+        };
         let kind = match study {
             StudyCommand::Sampling(args) => StudyKind::sampling(args, &case)?,
             StudyCommand::Period(args) => StudyKind::period(args, &case)?,
             StudyCommand::Regimes(args) => StudyKind::regimes(args, &case_toml)?,
+            StudyCommand::Horizon(args) => StudyKind::horizon(args, &case, recording.as_ref())?,
         };
         Ok(StudyPlan {
-            case_path: common.case,
+            case_path,
             case_toml,
             case,
             output,
@@ -741,6 +792,73 @@ impl StudyKind {
             ));
         }
         Ok(StudyKind::Period { runs, revolutions })
+    }
+
+    /// The numbers of recorded periods to compare, and the recording to read or to make:
+    /// a recording's own periods, reference and twins; a case's from the flags.
+    fn horizon(
+        args: HorizonStudyArgs,
+        case: &Case,
+        recording: Option<&RecordingReader>,
+    ) -> Result<Self> {
+        let HorizonStudyArgs {
+            common,
+            recorded_periods,
+            reference,
+            twins,
+            tau_rev,
+            seed,
+        } = args;
+        let mut recorded_periods = distinct(recorded_periods);
+        recorded_periods.sort_unstable();
+        let most = recorded_periods.iter().copied().max().unwrap_or(1);
+        let source = match recording {
+            Some(r) => {
+                let info = r.info();
+                let given = [
+                    ("--reference", reference.is_some()),
+                    ("--twins", twins.is_some()),
+                    ("--tau-rev", tau_rev.is_some()),
+                ];
+                if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                    return Err(usage(format!(
+                        "{flag}: {} is a recording, which has its own; give the flag with a case file",
+                        common.case.display()
+                    )));
+                }
+                if most > info.recorded_periods {
+                    return Err(usage(format!(
+                        "--recorded-periods {most}: {} holds {} recorded period(s); record it with --recorded-periods {most}",
+                        common.case.display(),
+                        info.recorded_periods
+                    )));
+                }
+                if info.twins == 0 {
+                    return Err(usage(format!(
+                        "{}: has no DEM twins, the yardstick of this study; record it with --twins 2 (at least 1)",
+                        common.case.display()
+                    )));
+                }
+                HorizonSource::Recording(common.case.clone())
+            }
+            None => {
+                let mut options = record_options(
+                    case,
+                    Tau::Revolutions(tau_rev.unwrap_or(1.0)),
+                    SamplingFlags::default(),
+                    reference.unwrap_or(DEFAULT_HORIZON_REFERENCE),
+                    AreaEncoding::Quantized,
+                )?;
+                options.twins = twins.unwrap_or(DEFAULT_HORIZON_TWINS);
+                options.recorded_periods = most;
+                HorizonSource::Record(options)
+            }
+        };
+        Ok(StudyKind::Horizon {
+            source,
+            recorded_periods,
+            seed,
+        })
     }
 
     /// One case per drum rotation period, made from the case text `case_toml`.

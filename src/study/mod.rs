@@ -3,6 +3,7 @@
 //! the terminal (or JSON), `study.json`, `study.md` and SVG plots into its directory.
 
 pub use tdex::flow;
+mod horizon;
 mod period;
 mod plots;
 mod regimes;
@@ -34,6 +35,11 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
             tau_rev,
             min_relative,
         } => regimes::run(plan, runs, *tau_rev, *min_relative),
+        StudyKind::Horizon {
+            source,
+            recorded_periods,
+            seed,
+        } => horizon::run(plan, source, recorded_periods, *seed),
     }
 }
 

@@ -103,3 +103,74 @@ pub fn means(title: &str, series: &[Series]) -> Result<String> {
         Ok(())
     })
 }
+
+/// One line of [`lines`]: `(x, y)` points joined in order.
+pub struct Line {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Labelled lines, one colour each, with an optional dashed horizontal reference line
+/// (e.g. a ratio of 1); a message instead when there is no point.
+pub fn lines(
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[Line],
+    reference: Option<(f64, &str)>,
+) -> Result<String> {
+    const PALETTE: [RGBColor; 6] = [
+        HOT,
+        COLD,
+        RGBColor(30, 140, 60),
+        RGBColor(150, 70, 170),
+        RGBColor(210, 130, 20),
+        GREY,
+    ];
+    render(SIZE, |root| {
+        let all = || series.iter().flat_map(|s| s.points.iter());
+        let x = span(all().map(|p| p.0), &[], 0.03);
+        let include: Vec<f64> = reference.iter().map(|r| r.0).collect();
+        let y = span(all().map(|p| p.1), &include, 0.08);
+        let (x0, x1) = (x.start, x.end);
+        let mut chart = chart(root, title, x, y)?;
+        axes(&mut chart, x_desc, y_desc)
+            .x_label_formatter(&|v| tick(*v))
+            .y_label_formatter(&|v| tick(*v))
+            .draw()?;
+        if all().next().is_none() {
+            message(root, "nothing to plot")?;
+        }
+        if let Some((level, label)) = reference {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(x0, level), (x1, level)],
+                    6,
+                    4,
+                    BLACK.stroke_width(1),
+                ))?
+                .label(label.to_string())
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
+        }
+        for (k, s) in series.iter().enumerate() {
+            let colour = PALETTE[k % PALETTE.len()];
+            chart
+                .draw_series(LineSeries::new(
+                    s.points.iter().copied(),
+                    colour.stroke_width(2),
+                ))?
+                .label(s.label.clone())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                });
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(GREY)
+            .label_font((FONT, 13))
+            .position(SeriesLabelPosition::UpperLeft)
+            .draw()?;
+        Ok(())
+    })
+}
