@@ -6,8 +6,8 @@ use crate::cli::InspectPlan;
 use crate::fmt;
 use anyhow::Result;
 use extrapolate::replay::{self, Bodies, CflRow};
-use extrapolate::sidecar::PairingSummary;
 use serde::Serialize;
+use tdex_format::extrapolation::Roles;
 use tdex_format::{
     ExtrapolationCosts, ExtrapolationReader, FormatError, RecordingCosts, RecordingReader, Snapshot,
 };
@@ -205,8 +205,10 @@ struct ExtrapolationInspection {
     conducting_walls: usize,
     scheme: String,
     periods: u32,
-    /// The pairing's summary as stored (see `tdex pair --json`).
-    pairing: serde_json::Value,
+    /// How the roles moved between periods, as stored: `pairing` (the pairing's summary, see
+    /// `tdex pair --json`) for one recorded period, `path` for several.
+    #[serde(flatten)]
+    roles: tdex_format::extrapolation::Roles,
     /// Σ m c T (J) over the particles at the first snapshot (`t1`) and at the last, with
     /// `m c = density · heat_capacity · (4/3)π r³` of the recording's material.
     total_heat_start: f64,
@@ -556,11 +558,8 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         conducting_walls,
         scheme: info.scheme.name().into(),
         periods: info.periods,
-        // keys in the order the file holds them (sorted)
-        pairing: match &info.roles {
-            tdex_format::extrapolation::Roles::Pairing(p) => serde_json::to_value(p)?,
-            tdex_format::extrapolation::Roles::Path(path) => serde_json::to_value(path)?,
-        },
+        // the pairing's keys in the order the file holds them (sorted)
+        roles: info.roles.clone(),
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,
@@ -600,8 +599,8 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
         at(last),
         s.snapshots.len()
     );
-    match serde_json::from_value::<PairingSummary>(s.pairing.clone()) {
-        Ok(p) => println!(
+    match &s.roles {
+        Roles::Pairing(p) => println!(
             "pairing       {} particles, mean distance {} diameters (total {}), k = {}, {} solve round(s), {}",
             p.particles,
             fmt::num(p.mean_distance_diameters),
@@ -614,7 +613,15 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
                 "NOT certified"
             }
         ),
-        Err(_) => println!("pairing       {}", s.pairing),
+        Roles::Path(path) => {
+            println!("path          {}", crate::extrapolation::path_words(path));
+            for p in &path.pairings {
+                println!(
+                    "pairing       {}",
+                    crate::extrapolation::path_pairing_words(p)
+                );
+            }
+        }
     }
     println!(
         "heat          Σ m c T {:.6e} J at the start, {:.6e} J at the end (relative change {:.2e})",

@@ -242,3 +242,123 @@ fn recorded_periods_outside_1_to_64_are_refused() {
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
 }
+
+/// The extrapolated snapshots of `path`, by index.
+fn extrapolated(path: &Path) -> Vec<tdex_format::Snapshot> {
+    tdex_format::ExtrapolationReader::open(path)
+        .unwrap()
+        .snapshots()
+        .unwrap()
+}
+
+/// `tdex extrapolate` of `rec` over `periods` into `out`, reproducibly; its `--json`.
+fn extrapolate(rec: &Path, out: &Path, periods: &str, extra: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--periods",
+        periods,
+        "-o",
+        out.to_str().unwrap(),
+        "--reproducible",
+        "--json",
+    ];
+    args.extend(extra);
+    serde_json::from_str(&tdex_ok(&args)).unwrap()
+}
+
+/// Issue 23's replay end to end on a real recording of three periods: through the recorded
+/// stretch the extrapolation is the recording's own continuation (the DEM's positions at t2
+/// and t3, and the temperatures of tables 2 and 3 applied in order to the DEM's t1, to the
+/// bit); then it jumps. Its first period alone is the paper's method on a recording of one
+/// period; the path is a function of the seed; `tdex pair` stores one pairing per start.
+#[test]
+fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
+    use extrapolate::replay::{self, Bodies, Scheme, SyncScratch, Table};
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let (p3, p1) = (dir.path().join("p3.mcap"), dir.path().join("p1.mcap"));
+    record(&case, &p3, &["--recorded-periods", "3", "--reference", "5"]);
+    record(&case, &p1, &["--reference", "5"]);
+
+    let x3 = dir.path().join("x3.mcap");
+    let json = extrapolate(&p3, &x3, "8", &[]);
+    let replayed: Vec<u64> = json["path"]["replayed"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert_eq!(replayed.len(), 8);
+    assert_eq!(replayed[..2], [2, 3], "the recording first: {json}");
+    assert!(replayed.iter().all(|p| (1..=3).contains(p)), "{json}");
+
+    let rec = RecordingReader::open(&p3).unwrap();
+    let dem = rec.snapshots().unwrap();
+    let out = extrapolated(&x3);
+    let bodies = Bodies::of(rec.info(), &dem[0]);
+    let mut temps = dem[1].temp.clone();
+    assert_eq!(out[0].index, 1);
+    assert_eq!(
+        out[0].temp, temps,
+        "the extrapolation starts from the DEM at t1"
+    );
+    let mut scratch = SyncScratch::default();
+    for k in [2usize, 3] {
+        let rows = rec.summary().unwrap().period_rows[k - 1];
+        let (table, _) = Table::read_period(&rec, &bodies, k as u32, rows).unwrap();
+        replay::apply_rows_with(
+            &mut temps,
+            &table.exchanges,
+            &bodies,
+            Scheme::Explicit,
+            &mut scratch,
+        );
+        scratch.flush(&mut temps);
+        let at = &out[k - 1];
+        assert_eq!(at.index as usize, k);
+        assert_eq!(at.pos, dem[k].pos, "t{k}: the DEM's own positions");
+        assert_eq!(at.id, dem[k].id, "t{k}: no pairing inside the recording");
+        assert_eq!(at.temp, temps, "t{k}: tables 2..{k} in order from t1");
+    }
+
+    // the first recorded period alone: the paper's method, as on a recording of one period
+    let (x31, x1) = (dir.path().join("x31.mcap"), dir.path().join("x1.mcap"));
+    extrapolate(&p3, &x31, "5", &["--recorded-periods", "1"]);
+    extrapolate(&p1, &x1, "5", &[]);
+    let (a, b) = (extrapolated(&x31), extrapolated(&x1));
+    assert_eq!(a.len(), 6);
+    for (a, b) in a.iter().zip(&b) {
+        assert_eq!((a.index, &a.temp, &a.id), (b.index, &b.temp, &b.id));
+    }
+
+    // the path from its seed: the same bytes again (the pairings reused from their
+    // sidecars), another path from another seed
+    let again = dir.path().join("again.mcap");
+    extrapolate(&p3, &again, "8", &[]);
+    assert_eq!(std::fs::read(&x3).unwrap(), std::fs::read(&again).unwrap());
+    let others: Vec<serde_json::Value> = (1..=4)
+        .map(|seed| {
+            let out = dir.path().join(format!("seed{seed}.mcap"));
+            extrapolate(&p3, &out, "8", &["--seed", &seed.to_string()])["path"]["replayed"].clone()
+        })
+        .collect();
+    assert!(
+        others.iter().any(|r| *r != json["path"]["replayed"]),
+        "four other seeds all drew the same path: {others:?}"
+    );
+
+    // one pairing per start, each stored and certified
+    let pairs: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["pair", p3.to_str().unwrap(), "--json"])).unwrap();
+    let pairs = pairs.as_array().unwrap();
+    assert_eq!(pairs.len(), 3);
+    for (m, p) in pairs.iter().enumerate() {
+        assert_eq!(
+            (p["end"].as_u64(), p["start"].as_u64()),
+            (Some(3), Some(m as u64))
+        );
+        assert_eq!(p["certified"], true, "{p}");
+        assert!(Path::new(p["pairing_file"].as_str().unwrap()).exists());
+    }
+}

@@ -366,7 +366,13 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     }
     let cost = |r: &serde_json::Value| r["recording_seconds"].as_f64().unwrap();
     assert!(cost(&runs[1]) > cost(&runs[0]), "{json}");
-    for f in ["study.json", "study.md", "ratio.svg", "means.svg", "horizon.mcap"] {
+    for f in [
+        "study.json",
+        "study.md",
+        "ratio.svg",
+        "means.svg",
+        "horizon.mcap",
+    ] {
         assert!(out.join(f).exists(), "{f} missing");
     }
 
@@ -392,7 +398,10 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     // a recording has its own reference periods; it cannot replay more periods than it holds
     for (flags, expect) in [
         (vec!["--reference", "5"], "--reference: "),
-        (vec!["--recorded-periods", "3"], "holds 2 recorded period(s)"),
+        (
+            vec!["--recorded-periods", "3"],
+            "holds 2 recorded period(s)",
+        ),
     ] {
         let mut args = vec!["study", "horizon", rec.to_str().unwrap()];
         args.extend(flags);

@@ -9,7 +9,8 @@ pub const TABLE_PERIODS: u32 = 100;
 /// Where the DEM cost of one period was measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum DemPeriodSource {
-    /// `seconds_reference / reference_periods`: the DEM run past `t1` without the recorder.
+    /// `seconds_reference / periods`: the DEM run past the recorded periods (`t1`, or `tP`
+    /// with several) without the recorder; `periods` is the number it ran.
     Reference { periods: u32 },
     /// `seconds_period − seconds_recorder`: the recorded period without the recorder's share.
     RecordedPeriod,
@@ -24,7 +25,9 @@ pub struct CostTable {
     pub pairing: f64,
     /// Whether the extrapolation reused a stored pairing (`pairing` is then its first cost).
     pub pairing_reused: bool,
-    /// Recorder overhead of the recorded period: the collision file (extrapolated column only).
+    /// Recording overhead (extrapolated column only): the recorder's time (the collision
+    /// file) and, with several recorded periods, the DEM of periods 2…P, which the
+    /// extrapolation pays for up front to have their tables.
     pub collision_file: f64,
     /// DEM seconds per period and where they were measured.
     pub tau_dem: f64,
@@ -38,32 +41,37 @@ pub struct CostTable {
 impl CostTable {
     /// The table from a recording's and an extrapolation's costs. `pairing_seconds` is the
     /// pairing summary's `seconds` (the cost of computing it, also when it was reused); when
-    /// absent the extrapolation's own `seconds_pairing` is used.
+    /// absent the extrapolation's own `seconds_pairing` is used. `recorded_periods` is the
+    /// recording's P: its reference stage ran the `K + 1 − P` periods after `tP`.
     pub fn new(
         recording: &RecordingCosts,
         reference_periods: u32,
+        recorded_periods: u32,
         extrapolation: &ExtrapolationCosts,
         pairing_seconds: Option<f64>,
     ) -> Self {
-        let dem_period = recording.seconds_period - recording.seconds_recorder;
-        let (tau_dem, tau_dem_source) =
-            if reference_periods > 0 && recording.seconds_reference > 0.0 {
-                (
-                    recording.seconds_reference / reference_periods as f64,
-                    DemPeriodSource::Reference {
-                        periods: reference_periods,
-                    },
-                )
-            } else {
-                (dem_period, DemPeriodSource::RecordedPeriod)
-            };
+        let recorded_periods = recorded_periods.max(1);
+        // the DEM's share of one recorded period (the recorder ran beside it)
+        let dem_period =
+            (recording.seconds_period - recording.seconds_recorder) / recorded_periods as f64;
+        let after_recorded = (reference_periods + 1).saturating_sub(recorded_periods);
+        let (tau_dem, tau_dem_source) = if after_recorded > 0 && recording.seconds_reference > 0.0 {
+            (
+                recording.seconds_reference / after_recorded as f64,
+                DemPeriodSource::Reference {
+                    periods: after_recorded,
+                },
+            )
+        } else {
+            (dem_period, DemPeriodSource::RecordedPeriod)
+        };
         CostTable {
             until_t1: recording.seconds_to_t0 + dem_period,
             pairing: pairing_seconds
                 .filter(|s| s.is_finite() && *s >= 0.0)
                 .unwrap_or(extrapolation.seconds_pairing),
             pairing_reused: extrapolation.pairing_reused,
-            collision_file: recording.seconds_recorder,
+            collision_file: recording.seconds_period - dem_period,
             tau_dem,
             tau_dem_source,
             tau_extra: extrapolation.seconds_per_period,
@@ -131,7 +139,7 @@ mod tests {
             rows_per_second: 0.0,
             rows: 0,
         };
-        let t = CostTable::new(&recording, 0, &extrapolation, Some(551.0));
+        let t = CostTable::new(&recording, 0, 1, &extrapolation, Some(551.0));
         assert_eq!(t.until_t1, 8580.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::RecordedPeriod);
         assert_eq!(t.total_dem(100.0), 398_580.0);
@@ -144,10 +152,45 @@ mod tests {
             seconds_reference: 3.0 * 4000.0,
             ..recording
         };
-        let t = CostTable::new(&with_reference, 3, &extrapolation, None);
+        let t = CostTable::new(&with_reference, 3, 1, &extrapolation, None);
         assert_eq!(t.tau_dem, 4000.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::Reference { periods: 3 });
         assert_eq!(t.pairing, 0.0);
         assert_eq!(t.until_t1, 8580.0);
+    }
+
+    /// Four recorded periods: the DEM to t1 is one of them, the other three and the
+    /// recorder are the recording's overhead, and the reference ran the periods after t4.
+    #[test]
+    fn several_recorded_periods_charge_their_dem_to_the_recording() {
+        let recording = RecordingCosts {
+            seconds_to_t0: 100.0,
+            seconds_period: 4.0 * 50.0 + 20.0,
+            seconds_reference: 5.0 * 48.0,
+            seconds_recorder: 20.0,
+            seconds_twins: 0.0,
+            seconds_each_period: vec![55.0; 4],
+            stage_seconds: Default::default(),
+            threads: 1,
+        };
+        let extrapolation = ExtrapolationCosts {
+            seconds_pairing: 2.0,
+            pairing_reused: false,
+            seconds_read_table: 0.0,
+            seconds_replay: 8.0,
+            seconds_per_period: 1.0,
+            rows_per_second: 0.0,
+            rows: 0,
+        };
+        // K = 8 reference periods: t2…t9, of which t5…t9 ran after the recorded t0…t4
+        let t = CostTable::new(&recording, 8, 4, &extrapolation, None);
+        assert_eq!(t.until_t1, 150.0);
+        assert_eq!(t.collision_file, 170.0);
+        assert_eq!(t.tau_dem, 48.0);
+        assert_eq!(t.tau_dem_source, DemPeriodSource::Reference { periods: 5 });
+        // the reference inside the recorded stretch: the recorded periods give the DEM's τ
+        let t = CostTable::new(&recording, 3, 4, &extrapolation, None);
+        assert_eq!(t.tau_dem, 50.0);
+        assert_eq!(t.tau_dem_source, DemPeriodSource::RecordedPeriod);
     }
 }

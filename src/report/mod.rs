@@ -161,6 +161,7 @@ pub fn write_with(
             Ok(CostTable::new(
                 rc,
                 info.reference_periods,
+                info.recorded_periods,
                 ec,
                 pairing_seconds,
             ))

@@ -140,7 +140,14 @@ pub fn evaluate(
     o.energy_error_mean_abs = (!abs.is_empty()).then(|| abs.iter().sum::<f64>() / abs.len() as f64);
     if let (Some(rc), Some(ec)) = (rec.costs(), ext.costs()) {
         let pairing = ext.info().roles.pairing_seconds();
-        let table = CostTable::new(rc, rec.info().reference_periods, ec, pairing);
+        let info = rec.info();
+        let table = CostTable::new(
+            rc,
+            info.reference_periods,
+            info.recorded_periods,
+            ec,
+            pairing,
+        );
         o.speedup_100 = table.speedup(TABLE_PERIODS as f64);
     }
     o.comparison = Some(c);
