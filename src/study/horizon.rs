@@ -7,7 +7,7 @@
 //! recording of P periods would hold (the recorder only reads the DEM's state), so every P
 //! is judged against the same DEM run and the same twins.
 
-use super::plots::{self, Line};
+use super::plots::{self, Line, LineKind};
 use crate::cli::{HorizonSource, StudyPlan};
 use crate::compare::{self, Comparison};
 use crate::extrapolation;
@@ -277,7 +277,9 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
     let ratio_lines: Vec<Line> = s
         .runs
         .iter()
-        .map(|e| Line {
+        .enumerate()
+        .map(|(n, e)| Line {
+            kind: LineKind::Extrapolation(n),
             label: format!("P = {}", e.recorded_periods),
             points: e
                 .comparison
@@ -305,14 +307,15 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
         let c = &first.comparison;
         let runs = std::iter::once(&c.dem_series).chain(&c.dem_runs_series);
         for (m, series) in runs.enumerate() {
-            let name = if m == 0 {
-                "DEM".to_string()
+            let (name, kind) = if m == 0 {
+                ("DEM".to_string(), LineKind::Dem)
             } else {
-                format!("DEM twin {m}")
+                (format!("DEM twin {m}"), LineKind::DemRun)
             };
             if groups {
                 for (which, pick) in [("hot", true), ("cold", false)] {
                     mean_lines.push(Line {
+                        kind,
                         label: format!("{name}, {which}"),
                         points: series
                             .iter()
@@ -322,18 +325,20 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
                 }
             } else {
                 mean_lines.push(Line {
+                    kind,
                     label: format!("{name}, bed"),
                     points: series.iter().map(|g| (g.t, g.bed)).collect(),
                 });
             }
         }
     }
-    for e in &s.runs {
+    for (n, e) in s.runs.iter().enumerate() {
         let periods = &e.comparison.periods;
         let label = format!("extrapolated, P = {}", e.recorded_periods);
         if groups {
             for (which, pick) in [("hot", true), ("cold", false)] {
                 mean_lines.push(Line {
+                    kind: LineKind::Extrapolation(n),
                     label: format!("{label}, {which}"),
                     points: periods
                         .iter()
@@ -352,6 +357,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             }
         } else {
             mean_lines.push(Line {
+                kind: LineKind::Extrapolation(n),
                 label: format!("{label}, bed"),
                 points: periods.iter().map(|p| (p.t, p.bed_mean_extra)).collect(),
             });

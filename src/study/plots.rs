@@ -108,6 +108,20 @@ pub fn means(title: &str, series: &[Series]) -> Result<String> {
 pub struct Line {
     pub label: String,
     pub points: Vec<(f64, f64)>,
+    pub kind: LineKind,
+}
+
+/// How a line of [`lines`] is drawn: the DEM runs in black and grey, so that the
+/// extrapolations' colours stand out against them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LineKind {
+    /// The DEM reference run: black.
+    Dem,
+    /// A further DEM run (a twin): grey.
+    DemRun,
+    /// Extrapolation number `n` (its hot and cold lines share it): the palette's `n`-th
+    /// colour.
+    Extrapolation(usize),
 }
 
 /// Labelled lines, one colour each, with an optional dashed horizontal reference line
@@ -125,7 +139,7 @@ pub fn lines(
         RGBColor(30, 140, 60),
         RGBColor(150, 70, 170),
         RGBColor(210, 130, 20),
-        GREY,
+        RGBColor(0, 150, 160),
     ];
     render(SIZE, |root| {
         let all = || series.iter().flat_map(|s| s.points.iter());
@@ -152,8 +166,12 @@ pub fn lines(
                 .label(label.to_string())
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
         }
-        for (k, s) in series.iter().enumerate() {
-            let colour = PALETTE[k % PALETTE.len()];
+        for s in series {
+            let colour = match s.kind {
+                LineKind::Dem => BLACK,
+                LineKind::DemRun => GREY,
+                LineKind::Extrapolation(n) => PALETTE[n % PALETTE.len()],
+            };
             chart
                 .draw_series(LineSeries::new(
                     s.points.iter().copied(),
