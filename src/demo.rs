@@ -70,6 +70,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         reproducible: false,
         recorded_periods: None,
         path_seed: None,
+        jump_targets: None,
     };
     let outcome = crate::with_workers(plan.threads, || {
         Ok(extrapolate::extrapolate_recording(

@@ -81,9 +81,13 @@ struct PathReport {
 /// A recurrence path in plain words: the periods used, the jumps and the runs between them.
 pub fn path_words(path: &RecurrencePath) -> String {
     let k = path.replayed.len();
+    let targets = path.jump_targets.as_ref().map_or(String::new(), |t| {
+        let list: Vec<String> = t.iter().map(u32::to_string).collect();
+        format!(", jumps only into periods {}", list.join(", "))
+    });
     format!(
-        "recorded periods 1 to {} (seed {}): {} jump{} in {k} period{}, {} periods between \
-         jumps on average",
+        "recorded periods 1 to {} (seed {}{targets}): {} jump{} in {k} period{}, {} periods \
+         between jumps on average",
         path.recorded_periods,
         path.seed,
         path.jumps(),
@@ -123,6 +127,7 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         reproducible: plan.reproducible,
         recorded_periods: plan.recorded_periods,
         path_seed: plan.seed,
+        jump_targets: plan.jump_to.clone(),
     };
     let outcome = crate::with_workers(plan.threads, || {
         extrapolate::extrapolate_recording(&request, tell).map_err(advice)
@@ -168,6 +173,10 @@ pub fn advice(e: ExtrapolateError) -> anyhow::Error {
         }
         ExtrapolateError::RecordedPeriods { recorded, .. } => {
             let advice = format!("give --recorded-periods between 1 and {recorded}");
+            anyhow::Error::new(e).context(advice)
+        }
+        ExtrapolateError::JumpTarget { used, .. } => {
+            let advice = format!("give --jump-to periods between 1 and {used}");
             anyhow::Error::new(e).context(advice)
         }
         e => e.into(),

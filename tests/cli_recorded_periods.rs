@@ -348,6 +348,29 @@ fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
         "four other seeds all drew the same path: {others:?}"
     );
 
+    // jumps restricted to the last period: after the recording, period 3 again and again;
+    // a target outside the periods used is refused, naming the flag
+    let near = dir.path().join("near.mcap");
+    let json = extrapolate(&p3, &near, "6", &["--jump-to", "3"]);
+    assert_eq!(json["path"]["replayed"], serde_json::json!([2, 3, 3, 3, 3, 3]));
+    assert_eq!(json["path"]["jump_targets"], serde_json::json!([3]));
+    let o = run_tdex(&[
+        "extrapolate",
+        p3.to_str().unwrap(),
+        "--periods",
+        "2",
+        "-o",
+        near.to_str().unwrap(),
+        "--jump-to",
+        "1,4",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--jump-to") && err.contains("jump target 4"),
+        "{err}"
+    );
+
     // one pairing per start, each stored and certified
     let pairs: serde_json::Value =
         serde_json::from_str(&tdex_ok(&["pair", p3.to_str().unwrap(), "--json"])).unwrap();

@@ -38,6 +38,10 @@ pub struct ExtrapolationRequest {
     /// Seed of the recurrence path's jumps (`None`: the case's `seed`, else 0). Plays no
     /// part with one recorded period.
     pub path_seed: Option<u64>,
+    /// The recorded periods (1-based, within the `recorded_periods` used) a jump may enter;
+    /// `None`: every one of them. A user restricts them to the starts whose pairing with
+    /// the recording's end is short (`tdex pair` prints each one's distance).
+    pub jump_targets: Option<Vec<u32>>,
 }
 
 /// Where the replay keeps the collision table.
@@ -109,7 +113,27 @@ pub fn extrapolate_recording(
         });
     }
     let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
-    let steps = RecurrencePolicy::steps(used, seed, request.periods);
+    let targets = match &request.jump_targets {
+        Some(targets) => {
+            if let Some(&bad) = targets.iter().find(|t| !(1..=used).contains(*t)) {
+                return Err(ExtrapolateError::JumpTarget {
+                    recording: request.recording.clone(),
+                    target: bad,
+                    used,
+                });
+            }
+            let mut targets = targets.clone();
+            targets.sort_unstable();
+            targets.dedup();
+            // every period as a target is the default path: nothing to record
+            (!targets.is_empty() && targets.len() < used as usize).then_some(targets)
+        }
+        None => None,
+    };
+    let steps: Vec<Step> =
+        RecurrencePolicy::with_targets(used, seed, targets.as_deref().unwrap_or(&[]))
+            .take(request.periods as usize)
+            .collect();
     // the paper's method pairs t1 to t0 even for no period (as it always has); a path
     // pairs only the starts it jumps to
     let starts = if used == 1 {
@@ -241,6 +265,7 @@ pub fn extrapolate_recording(
             Roles::Path(RecurrencePath {
                 recorded_periods: used,
                 seed,
+                jump_targets: targets.clone(),
                 replayed: steps.iter().map(|s| s.period()).collect(),
                 pairings: pairings
                     .iter()

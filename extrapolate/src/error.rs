@@ -35,6 +35,16 @@ pub enum ExtrapolateError {
         asked: u32,
         recorded: u32,
     },
+    #[error(
+        "{}: jump target {target} is not one of the {used} recorded period(s) replayed \
+         (jump targets must be between 1 and {used})",
+        recording.display()
+    )]
+    JumpTarget {
+        recording: PathBuf,
+        target: u32,
+        used: u32,
+    },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -51,7 +61,8 @@ impl Classify for ExtrapolateError {
             ExtrapolateError::Pairing(_)
             | ExtrapolateError::Replay(_)
             | ExtrapolateError::Refused { .. }
-            | ExtrapolateError::RecordedPeriods { .. } => Fault::Input,
+            | ExtrapolateError::RecordedPeriods { .. }
+            | ExtrapolateError::JumpTarget { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)

@@ -25,24 +25,47 @@ impl Step {
 }
 
 /// The path policy: start at `t1`, the end of recorded period 1; after period `p < P` go on
-/// with `p + 1`; after period `P` jump to the start of a period drawn uniformly from
-/// `1..=P`. A path is a function of `(P, seed)` and the number of periods alone.
+/// with `p + 1`; after period `P` jump to the start of a period drawn uniformly from the jump
+/// targets (by default all of `1..=P`). A path is a function of `(P, targets, seed)` and the
+/// number of periods alone.
 #[derive(Debug, Clone)]
 pub struct RecurrencePolicy {
     recorded_periods: u32,
+    /// The periods a jump may enter, distinct and ascending (`1..=P` unless restricted).
+    targets: Vec<u32>,
     rng: Xoshiro256PlusPlus,
     /// The recorded period whose end the roles are at.
     at_end_of: u32,
 }
 
 impl RecurrencePolicy {
-    /// The path through `recorded_periods` periods (at least 1), its jumps drawn from `seed`.
+    /// The path through `recorded_periods` periods (at least 1), its jumps drawn from `seed`
+    /// among all the recorded periods.
     pub fn new(recorded_periods: u32, seed: u64) -> Self {
+        let recorded_periods = recorded_periods.max(1);
         Self {
-            recorded_periods: recorded_periods.max(1),
+            recorded_periods,
+            targets: (1..=recorded_periods).collect(),
             rng: Xoshiro256PlusPlus::seed_from_u64(seed),
             at_end_of: 1,
         }
+    }
+
+    /// The path whose jumps enter only the periods `targets` (1-based; the caller checked
+    /// them: within `1..=recorded_periods`, at least one). With every period as a target the
+    /// path is [`RecurrencePolicy::new`]'s, draw for draw.
+    pub fn with_targets(recorded_periods: u32, seed: u64, targets: &[u32]) -> Self {
+        let mut policy = Self::new(recorded_periods, seed);
+        let mut targets = targets.to_vec();
+        targets.sort_unstable();
+        targets.dedup();
+        debug_assert!(targets
+            .iter()
+            .all(|t| (1..=policy.recorded_periods).contains(t)));
+        if !targets.is_empty() {
+            policy.targets = targets;
+        }
+        policy
     }
 
     /// The first `periods` steps of the path.
@@ -57,13 +80,14 @@ impl RecurrencePolicy {
     /// values of `x`, so no start is more likely than another by more than P/2⁶⁴ ≤ 2⁻⁵⁸
     /// relative (P ≤ 64): far below anything 100 or even 10⁶ periods could detect, and
     /// without the rejection loop that would make the number of draws depend on the values.
-    /// One recorded period draws nothing: the paper's method uses no generator.
+    /// One recorded period draws nothing: the paper's method uses no generator; nor does a
+    /// single jump target.
     fn draw_start(&mut self) -> u32 {
-        let p = self.recorded_periods;
-        if p == 1 {
-            return 1;
+        let n = self.targets.len() as u128;
+        if self.recorded_periods == 1 || n == 1 {
+            return self.targets[0];
         }
-        ((u128::from(self.rng.next_u64()) * u128::from(p)) >> 64) as u32 + 1
+        self.targets[((u128::from(self.rng.next_u64()) * n) >> 64) as usize]
     }
 }
 
@@ -158,6 +182,30 @@ mod tests {
     }
 
     const PINNED_SEED_0_P3: [u32; 12] = [2, 3, 1, 2, 3, 2, 3, 2, 3, 1, 2, 3];
+
+    #[test]
+    fn restricted_jumps_enter_only_their_targets_and_all_targets_are_the_default() {
+        let all = RecurrencePolicy::with_targets(5, 9, &[5, 1, 2, 3, 4, 4])
+            .take(200)
+            .collect::<Vec<_>>();
+        assert_eq!(all, RecurrencePolicy::steps(5, 9, 200));
+        let near: Vec<Step> = RecurrencePolicy::with_targets(5, 9, &[5, 4])
+            .take(200)
+            .collect();
+        assert_eq!(
+            near[..4],
+            [
+                Step::Continue { period: 2 },
+                Step::Continue { period: 3 },
+                Step::Continue { period: 4 },
+                Step::Continue { period: 5 }
+            ]
+        );
+        assert_eq!(starts(&near), [4, 5]);
+        // one target: no draw, the same jump every time
+        let one: Vec<Step> = RecurrencePolicy::with_targets(3, 9, &[2]).take(20).collect();
+        assert_eq!(starts(&one), [2]);
+    }
 
     #[test]
     fn the_starts_are_drawn_uniformly() {

@@ -164,6 +164,7 @@ fn request(recording: &Path, output: &Path, periods: u32) -> ExtrapolationReques
         reproducible: true,
         recorded_periods: None,
         path_seed: None,
+        jump_targets: None,
     }
 }
 

@@ -195,6 +195,16 @@ pub struct ExtrapolateArgs {
     /// case's seed). The same seed gives the same path and the same bytes.
     #[arg(long)]
     pub seed: Option<u64>,
+    /// The recorded periods a jump may enter, comma-separated (default: all the periods
+    /// used): e.g. those whose start is close to the recording's end (`tdex pair` prints
+    /// each pairing's mean distance).
+    #[arg(
+        long = "jump-to",
+        value_name = "PERIODS",
+        value_delimiter = ',',
+        value_parser = periods_used()
+    )]
+    pub jump_to: Option<Vec<u32>>,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

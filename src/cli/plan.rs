@@ -180,6 +180,8 @@ pub struct ExtrapolatePlan {
     pub recorded_periods: Option<u32>,
     /// `--seed`: the recurrence path's seed (`None`: the case's).
     pub seed: Option<u64>,
+    /// `--jump-to`: the periods a jump may enter (`None`: all the periods used).
+    pub jump_to: Option<Vec<u32>>,
     pub json: bool,
 }
 
@@ -399,6 +401,7 @@ impl ExtrapolatePlan {
             reproducible: args.reproducible,
             recorded_periods: args.recorded_periods,
             seed: args.seed,
+            jump_to: args.jump_to,
             json: args.json,
         })
     }

@@ -120,6 +120,7 @@ pub fn run(
             reproducible: false,
             recorded_periods: Some(p),
             path_seed: seed,
+            jump_targets: None,
         };
         crate::with_workers(plan.threads, || {
             Ok(extrapolate::extrapolate_recording(

@@ -115,6 +115,7 @@ pub fn evaluate(
         reproducible: false,
         recorded_periods: None,
         path_seed: None,
+        jump_targets: None,
     };
     if let Err(e) = crate::with_workers(threads, || {
         Ok(extrapolate::extrapolate_recording(

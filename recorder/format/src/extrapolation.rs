@@ -69,6 +69,10 @@ pub struct RecurrencePath {
     pub recorded_periods: u32,
     /// Seed of the jumps' generator (xoshiro256++ seeded with `seed_from_u64`).
     pub seed: u64,
+    /// The periods a jump could enter when the user restricted them (`--jump-to`); absent:
+    /// every recorded period used.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jump_targets: Option<Vec<u32>>,
     /// The recorded period (1-based) replayed at each extrapolated period `k = 1 … K`.
     pub replayed: Vec<u32>,
     /// The pairing of each start the path jumped to, by start: snapshot `t_end` (`end` =
