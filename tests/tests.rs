@@ -18,6 +18,7 @@ mod cli_run;
 mod cli_study;
 mod drum;
 mod fuzz_corpus;
+mod golden_outputs;
 mod physics_collision;
 mod physics_conduction;
 mod record;
