@@ -352,7 +352,10 @@ fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
     // a target outside the periods used is refused, naming the flag
     let near = dir.path().join("near.mcap");
     let json = extrapolate(&p3, &near, "6", &["--jump-to", "3"]);
-    assert_eq!(json["path"]["replayed"], serde_json::json!([2, 3, 3, 3, 3, 3]));
+    assert_eq!(
+        json["path"]["replayed"],
+        serde_json::json!([2, 3, 3, 3, 3, 3])
+    );
     assert_eq!(json["path"]["jump_targets"], serde_json::json!([3]));
     let o = run_tdex(&[
         "extrapolate",

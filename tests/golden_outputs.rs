@@ -33,7 +33,11 @@ fn one_recorded_period_gives_the_same_bytes_as_before() {
     };
     let expected = sums(std::fs::read_to_string(repo().join("tests/golden/SHA256")).unwrap());
     let made = sums(std::fs::read_to_string(out.join("SHA256")).unwrap());
-    assert_eq!(expected.len(), 14, "tests/golden/SHA256 lists the 14 outputs");
+    assert_eq!(
+        expected.len(),
+        14,
+        "tests/golden/SHA256 lists the 14 outputs"
+    );
     let changed: Vec<&String> = expected
         .iter()
         .zip(&made)

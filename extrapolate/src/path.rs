@@ -203,7 +203,9 @@ mod tests {
         );
         assert_eq!(starts(&near), [4, 5]);
         // one target: no draw, the same jump every time
-        let one: Vec<Step> = RecurrencePolicy::with_targets(3, 9, &[2]).take(20).collect();
+        let one: Vec<Step> = RecurrencePolicy::with_targets(3, 9, &[2])
+            .take(20)
+            .collect();
         assert_eq!(starts(&one), [2]);
     }
 
