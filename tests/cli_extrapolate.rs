@@ -84,13 +84,13 @@ fn a_table_over_the_limit_is_streamed_and_gives_the_same_file_as_in_memory() {
             (m["table"].as_str(), m["reason"].as_str()),
             (Some("in_memory"), Some("fits"))
         );
-        assert_eq!(m["table_bytes"].as_u64(), Some(rows * 24));
+        assert_eq!(m["table_bytes"].as_u64(), Some(rows * 16));
         let (in_memory, streamed) = (
             m["in_memory_bytes"].as_u64().unwrap(),
             m["streamed_bytes"].as_u64().unwrap(),
         );
         assert!(
-            streamed < in_memory && in_memory - streamed >= rows * 24,
+            streamed < in_memory && in_memory - streamed >= rows * 16,
             "{m}"
         );
         assert!(stated.contains("memory        needs"), "{stated}");

@@ -5,7 +5,7 @@
 use crate::cache;
 use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
-    self, Bodies, CflRow, Exchange, MemoryNeeds, MemoryPlan, Scheme, SyncScratch, Table, TableMode,
+    self, Bodies, CflRow, Exchanges, MemoryNeeds, MemoryPlan, Scheme, SyncScratch, Table, TableMode,
 };
 use crate::sidecar::{PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
@@ -297,7 +297,7 @@ pub fn extrapolate_recording(
     let heat_t1 = replay::total_heat(&temps, &bodies);
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
-    let mut exchanges: Vec<Exchange> = Vec::new();
+    let mut exchanges = Exchanges::default();
     // the output snapshot: t_p's positions, radii and velocities, the extrapolated
     // temperatures, and as `id` the particle that plays each role (it moves with its heat,
     // at the jumps only)
@@ -329,12 +329,9 @@ pub fn extrapolate_recording(
                 let (batches, offset) = replay::period_batches(&reader, p);
                 for batch in batches {
                     exchanges.clear();
-                    exchanges.extend(
-                        batch?
-                            .rows
-                            .iter()
-                            .map(|r| Exchange::in_period(r, &info, offset)),
-                    );
+                    for r in &batch?.rows {
+                        exchanges.push_row(r, &info, offset);
+                    }
                     replay::apply_rows_with(
                         &mut temps,
                         &exchanges,

@@ -3,7 +3,7 @@
 //! path's seed, heat over 500 periods, `P' = 1` as the paper's method, the refusal of
 //! `P' > P`, streamed against in memory.
 
-use extrapolate::replay::{self, Bodies, Exchange, Scheme};
+use extrapolate::replay::{self, Bodies, Exchanges, Scheme};
 use extrapolate::{
     extrapolate_recording, ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest,
     MemoryLimit, TableChoice,
@@ -210,10 +210,10 @@ fn the_recorded_stretch_replays_the_tables_in_order_with_no_pairing() {
         // and particles unchanged, at the DEM's own positions of t2 and t3
         let mut expected = syn.snapshots[1].temp.clone();
         for k in 2..=3 {
-            let table: Vec<Exchange> = syn.rows[k - 1]
-                .iter()
-                .map(|r| Exchange::of(r, &info))
-                .collect();
+            let mut table = Exchanges::default();
+            for r in &syn.rows[k - 1] {
+                table.push_row(r, &info, 0);
+            }
             replay::apply_rows(&mut expected, &table, &bodies, scheme);
             // the file holds t1 … t7
             let s = &snaps[k - 1];

@@ -8,7 +8,10 @@ mod table;
 
 pub use memory::{MemoryNeeds, MemoryPlan, ModeReason, TableMode};
 pub use schemes::{apply_rows, apply_rows_with, Scheme, SyncScratch};
-pub use table::{period_batches, scan, scan_period, Bodies, CflRow, Exchange, Table, TableScan};
+pub use table::{
+    period_batches, scan, scan_period, Bodies, CflRow, Exchange, Exchanges, StartRun, Table,
+    TableScan,
+};
 
 /// Why a table cannot be replayed.
 #[derive(Debug, thiserror::Error)]

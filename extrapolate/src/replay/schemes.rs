@@ -1,7 +1,7 @@
 //! The three ways of applying a period's rows (docs/method.md §6). All conserve `Σ C T` between
 //! particles; a wall row adds the heat the wall gives.
 
-use super::table::{Bodies, Exchange};
+use super::table::{Bodies, Exchanges};
 
 pub use tdex_format::Scheme;
 
@@ -28,7 +28,7 @@ impl SyncScratch {
 }
 
 /// Applies a whole period's `rows` (in apparition order) to the role temperatures `temps`.
-pub fn apply_rows(temps: &mut [f64], rows: &[Exchange], bodies: &Bodies, scheme: Scheme) {
+pub fn apply_rows(temps: &mut [f64], rows: &Exchanges, bodies: &Bodies, scheme: Scheme) {
     let mut scratch = SyncScratch::default();
     apply_rows_with(temps, rows, bodies, scheme, &mut scratch);
     scratch.flush(temps);
@@ -36,14 +36,15 @@ pub fn apply_rows(temps: &mut [f64], rows: &[Exchange], bodies: &Bodies, scheme:
 
 /// Applies consecutive rows of a period with caller-owned scratch: a streaming replay calls
 /// it batch after batch, and a synchronous group split between two batches stays pending in
-/// `scratch` until its start step changes. End the period with [`SyncScratch::flush`].
+/// `scratch` until the start step of a run of rows changes. End the period with [`SyncScratch::flush`].
 pub fn apply_rows_with(
     temps: &mut [f64],
-    rows: &[Exchange],
+    rows: &Exchanges,
     bodies: &Bodies,
     scheme: Scheme,
     scratch: &mut SyncScratch,
 ) {
+    let (runs, rows) = (rows.runs(), rows.rows());
     let n = bodies.particles() as u32;
     let wall_t = |j: u32| bodies.wall_temperature[(j - n) as usize];
     match scheme {
@@ -79,25 +80,30 @@ pub fn apply_rows_with(
             if scratch.delta.len() != temps.len() {
                 scratch.delta = vec![0.0; temps.len()];
             }
-            for e in rows {
-                if scratch.group_start != Some(e.start_step) {
+            let mut from = 0;
+            for run in runs {
+                let to = from + run.rows as usize;
+                if scratch.group_start != Some(run.start_step) {
                     scratch.flush(temps);
-                    scratch.group_start = Some(e.start_step);
+                    scratch.group_start = Some(run.start_step);
                 }
-                let (k, l) = (e.i as usize, e.j as usize);
-                let q = if e.j < n {
-                    e.conductance_time * (temps[k] - temps[l])
-                } else if let Some(tw) = wall_t(e.j) {
-                    e.conductance_time * (temps[k] - tw)
-                } else {
-                    continue;
-                };
-                scratch.delta[k] -= q * bodies.inverse_capacity[k];
-                scratch.touched.push(e.i);
-                if e.j < n {
-                    scratch.delta[l] += q * bodies.inverse_capacity[l];
-                    scratch.touched.push(e.j);
+                for e in &rows[from..to] {
+                    let (k, l) = (e.i as usize, e.j as usize);
+                    let q = if e.j < n {
+                        e.conductance_time * (temps[k] - temps[l])
+                    } else if let Some(tw) = wall_t(e.j) {
+                        e.conductance_time * (temps[k] - tw)
+                    } else {
+                        continue;
+                    };
+                    scratch.delta[k] -= q * bodies.inverse_capacity[k];
+                    scratch.touched.push(e.i);
+                    if e.j < n {
+                        scratch.delta[l] += q * bodies.inverse_capacity[l];
+                        scratch.touched.push(e.j);
+                    }
                 }
+                from = to;
             }
         }
     }
@@ -105,6 +111,7 @@ pub fn apply_rows_with(
 
 #[cfg(test)]
 mod tests {
+    use super::super::table::Exchange;
     use super::*;
 
     /// Bodies: `n` particles of varied capacity and one wall at 350 K.
@@ -117,8 +124,9 @@ mod tests {
         }
     }
 
-    /// Rows in apparition order with runs of equal starts (synchronous groups) and wall rows.
-    fn rows(n: u32, count: u32) -> Vec<Exchange> {
+    /// Rows in apparition order with their starts, in runs of equal starts (synchronous
+    /// groups), and wall rows.
+    fn rows(n: u32, count: u32) -> Vec<(Exchange, u32)> {
         (0..count)
             .map(|r| {
                 let i = (r * 7919) % (n - 1);
@@ -127,14 +135,22 @@ mod tests {
                 } else {
                     i + 1 + (r * 104_729) % (n - 1 - i)
                 };
-                Exchange {
+                let e = Exchange {
                     i,
                     j,
-                    start_step: r / 5,
                     conductance_time: 1e-4 * (1 + r % 13) as f64,
-                }
+                };
+                (e, r / 5)
             })
             .collect()
+    }
+
+    fn exchanges(rows: &[(Exchange, u32)]) -> Exchanges {
+        let mut exchanges = Exchanges::default();
+        for &(e, start) in rows {
+            exchanges.push(e, start);
+        }
+        exchanges
     }
 
     /// The streamed replay hands the rows over batch by batch (a synchronous group may
@@ -144,12 +160,15 @@ mod tests {
         let n = 40;
         let bodies = bodies(n as usize);
         let table = rows(n, 1000);
+        let whole_table = exchanges(&table);
+        assert_eq!(whole_table.runs().len(), 200);
+        assert_eq!(whole_table.len(), 1000);
         let start: Vec<f64> = (0..n).map(|k| 10.0 + (k % 3) as f64 * 10.0).collect();
         for scheme in Scheme::ALL {
             let mut whole = start.clone();
             let mut scratch = SyncScratch::default();
             for _period in 0..3 {
-                apply_rows_with(&mut whole, &table, &bodies, scheme, &mut scratch);
+                apply_rows_with(&mut whole, &whole_table, &bodies, scheme, &mut scratch);
                 scratch.flush(&mut whole);
             }
             assert_ne!(whole, start, "{scheme:?}: the rows must change something");
@@ -158,7 +177,8 @@ mod tests {
                 let mut scratch = SyncScratch::default();
                 for _period in 0..3 {
                     for chunk in table.chunks(batch) {
-                        apply_rows_with(&mut streamed, chunk, &bodies, scheme, &mut scratch);
+                        let chunk = exchanges(chunk);
+                        apply_rows_with(&mut streamed, &chunk, &bodies, scheme, &mut scratch);
                     }
                     scratch.flush(&mut streamed);
                 }

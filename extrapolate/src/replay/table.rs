@@ -1,19 +1,94 @@
-//! The table in the replay's compact form: each row as its two bodies, its start and the
-//! heat it can carry per kelvin, `H·m` (J/K); 24 bytes a row.
+//! The table in the replay's compact form: each row as its two bodies and the heat it can
+//! carry per kelvin, `H·m` (J/K), 16 bytes a row; the rows' start steps only as the runs of
+//! equal starts the synchronous scheme applies together.
 
 use tdex_format::{CollisionRow, TableBatch};
 use tdex_format::{FormatError, RecordingInfo, RecordingReader, Snapshot};
 
-/// One row ready to apply.
+/// One row ready to apply. The replay streams every row each period, so its speed is the
+/// memory bandwidth over this size: no padding, no start step (kept in [`Exchanges`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Exchange {
     /// Particle (role) id.
     pub i: u32,
     /// Other particle id, or `particles + wall` for a wall row.
     pub j: u32,
-    pub start_step: u32,
     /// `H · m`: conductance times the row's duration (J/K).
     pub conductance_time: f64,
+}
+
+/// A run of consecutive rows that start at the same step (a synchronous group, or part of
+/// one when it straddles two batches or exceeds `u32::MAX` rows).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StartRun {
+    /// Steps from the period's start.
+    pub start_step: u32,
+    pub rows: u32,
+}
+
+/// Rows in apparition order and the runs of equal start steps they form: a run costs 8
+/// bytes, and a period has at most one per time step, against one row per contact and step.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Exchanges {
+    rows: Vec<Exchange>,
+    runs: Vec<StartRun>,
+}
+
+impl Exchanges {
+    /// Room for `rows` rows reserved exactly (the memory estimate counts rows × 16 B, not
+    /// the up to twice as much of a growing Vec); unreserved if that much cannot be had.
+    pub fn with_room_for(rows: u64) -> Self {
+        let mut exchanges = Self::default();
+        let _ = exchanges
+            .rows
+            .try_reserve_exact(usize::try_from(rows).unwrap_or(0));
+        exchanges
+    }
+
+    /// Appends a row that starts `start_step` steps after its period's start.
+    pub fn push(&mut self, exchange: Exchange, start_step: u32) {
+        self.rows.push(exchange);
+        match self.runs.last_mut() {
+            Some(run) if run.start_step == start_step && run.rows < u32::MAX => run.rows += 1,
+            _ => self.runs.push(StartRun {
+                start_step,
+                rows: 1,
+            }),
+        }
+    }
+
+    /// Appends a decoded row of a recorded period that starts `offset` steps after `t0`.
+    pub fn push_row(&mut self, row: &CollisionRow, info: &RecordingInfo, offset: u64) {
+        self.push(Exchange::of(row, info), start_in_period(row, offset));
+    }
+
+    pub fn clear(&mut self) {
+        self.rows.clear();
+        self.runs.clear();
+    }
+
+    pub fn len(&self) -> usize {
+        self.rows.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.rows.is_empty()
+    }
+
+    /// The rows in apparition order.
+    pub fn rows(&self) -> &[Exchange] {
+        &self.rows
+    }
+
+    /// The runs of equal start steps, in order; their rows add up to [`Self::len`].
+    pub fn runs(&self) -> &[StartRun] {
+        &self.runs
+    }
+}
+
+/// The row's start counted from the start of its recorded period, `offset` steps after `t0`.
+fn start_in_period(row: &CollisionRow, offset: u64) -> u32 {
+    row.start_step.wrapping_sub(offset) as u32
 }
 
 /// Heat capacities of the particles and temperatures of the conducting walls.
@@ -61,12 +136,6 @@ impl Bodies {
 impl Exchange {
     /// A decoded row, with the recording's conduction constants.
     pub fn of(row: &CollisionRow, info: &RecordingInfo) -> Self {
-        Self::in_period(row, info, 0)
-    }
-
-    /// [`Exchange::of`] of a row of a recorded period that starts `offset` steps after
-    /// `t0`: its start counted from the period's start.
-    pub fn in_period(row: &CollisionRow, info: &RecordingInfo, offset: u64) -> Self {
         let conductivity = if row.j >= info.particles {
             info.wall_conductivity
         } else {
@@ -75,7 +144,6 @@ impl Exchange {
         Self {
             i: row.i,
             j: row.j,
-            start_step: row.start_step.wrapping_sub(offset) as u32,
             conductance_time: conductivity * row.sqrt_area * row.duration_steps as f64 * info.dt,
         }
     }
@@ -108,23 +176,23 @@ pub struct TableScan {
 pub fn scan(
     reader: &RecordingReader,
     bodies: &Bodies,
-    each: impl FnMut(&CollisionRow, Exchange),
+    mut each: impl FnMut(&CollisionRow, Exchange),
 ) -> Result<TableScan, FormatError> {
-    scan_batches(reader.table(), reader.info(), 0, bodies, each)
+    scan_batches(reader.table(), reader.info(), 0, bodies, |r, e, _| {
+        each(r, e)
+    })
 }
 
-/// [`scan`] of the rows of recorded period `period` (1-based) alone, their [`Exchange`]
-/// starts counted from the period's own start (a synchronous group never spans two
-/// periods). The table of a recording of one period is its whole table, read as [`scan`]
+/// [`scan`] of the rows of recorded period `period` (1-based) alone. The table of a recording of one period is its whole table, read as [`scan`]
 /// reads it.
 pub fn scan_period(
     reader: &RecordingReader,
     bodies: &Bodies,
     period: u32,
-    each: impl FnMut(&CollisionRow, Exchange),
+    mut each: impl FnMut(&CollisionRow, Exchange),
 ) -> Result<TableScan, FormatError> {
     let (batches, offset) = period_batches(reader, period);
-    scan_batches(batches, reader.info(), offset, bodies, each)
+    scan_batches(batches, reader.info(), offset, bodies, |r, e, _| each(r, e))
 }
 
 /// The batches of recorded period `period` (1-based) and the steps from `t0` to its start:
@@ -148,20 +216,21 @@ pub fn period_batches(
     )
 }
 
-/// The rows of `batches` handed to `each`, their starts moved back by `offset` steps, and
-/// the worst CFL row among them.
+/// The rows of `batches` handed to `each` with their starts counted from the period's own
+/// start, `offset` steps after `t0` (a synchronous group never spans two periods), and the
+/// worst CFL row among them.
 fn scan_batches(
     batches: impl Iterator<Item = Result<TableBatch, FormatError>>,
     info: &RecordingInfo,
     offset: u64,
     bodies: &Bodies,
-    mut each: impl FnMut(&CollisionRow, Exchange),
+    mut each: impl FnMut(&CollisionRow, Exchange, u32),
 ) -> Result<TableScan, FormatError> {
     let mut found = TableScan::default();
     for batch in batches {
         let batch = batch?;
         for (k, r) in batch.rows.iter().enumerate() {
-            let e = Exchange::in_period(r, info, offset);
+            let e = Exchange::of(r, info);
             let cfl = bodies.cfl(&e);
             if found.worst.is_none_or(|w| cfl > w.cfl) {
                 found.worst = Some(CflRow {
@@ -174,7 +243,7 @@ fn scan_batches(
                     cfl,
                 });
             }
-            each(r, e);
+            each(r, e, start_in_period(r, offset));
         }
         found.rows += batch.rows.len() as u64;
         found.batches += 1;
@@ -185,7 +254,7 @@ fn scan_batches(
 /// The whole table decoded once and kept in memory (the replay reads it every period).
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Table {
-    pub exchanges: Vec<Exchange>,
+    pub exchanges: Exchanges,
 }
 
 impl Table {
@@ -195,11 +264,10 @@ impl Table {
         reader: &RecordingReader,
         bodies: &Bodies,
     ) -> Result<(Self, Option<CflRow>), FormatError> {
-        // sized once from the recording (the memory estimate counts rows × 24 B, not the
-        // up to twice as much of a growing Vec); unreserved if that much cannot be had
-        let mut exchanges = Vec::new();
-        let _ = exchanges.try_reserve_exact(usize::try_from(reader.table_rows()).unwrap_or(0));
-        let found = scan(reader, bodies, |_, e| exchanges.push(e))?;
+        let mut exchanges = Exchanges::with_room_for(reader.table_rows());
+        let found = scan_batches(reader.table(), reader.info(), 0, bodies, |_, e, start| {
+            exchanges.push(e, start)
+        })?;
         Ok((Self { exchanges }, found.worst))
     }
 
@@ -211,9 +279,11 @@ impl Table {
         period: u32,
         rows: u64,
     ) -> Result<(Self, Option<CflRow>), FormatError> {
-        let mut exchanges = Vec::new();
-        let _ = exchanges.try_reserve_exact(usize::try_from(rows).unwrap_or(0));
-        let found = scan_period(reader, bodies, period, |_, e| exchanges.push(e))?;
+        let mut exchanges = Exchanges::with_room_for(rows);
+        let (batches, offset) = period_batches(reader, period);
+        let found = scan_batches(batches, reader.info(), offset, bodies, |_, e, start| {
+            exchanges.push(e, start)
+        })?;
         Ok((Self { exchanges }, found.worst))
     }
 }
