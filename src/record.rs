@@ -177,7 +177,7 @@ fn print_human(report: &RecordReport) {
                 format!("the {p} recorded periods"),
                 format!(
                     "{} reference periods after t{p}",
-                    (report.sampling.reference_periods + 1).saturating_sub(p)
+                    tdex_format::periods_after_recorded(p, report.sampling.reference_periods)
                 ),
             ),
         };

@@ -54,7 +54,8 @@ impl CostTable {
         // the DEM's share of one recorded period (the recorder ran beside it)
         let dem_period =
             (recording.seconds_period - recording.seconds_recorder) / recorded_periods as f64;
-        let after_recorded = (reference_periods + 1).saturating_sub(recorded_periods);
+        let after_recorded =
+            tdex_format::periods_after_recorded(recorded_periods, reference_periods);
         let (tau_dem, tau_dem_source) = if after_recorded > 0 && recording.seconds_reference > 0.0 {
             (
                 recording.seconds_reference / after_recorded as f64,

@@ -203,8 +203,7 @@ impl RecordingInfo {
     /// Index of the last snapshot of the run: `tP` or the last reference `t_{K+1}`, whichever
     /// is later (the reference snapshots inside the recorded stretch are its own snapshots).
     pub fn last_snapshot(&self) -> u32 {
-        self.recorded_periods
-            .max(self.reference_periods.saturating_add(1))
+        last_snapshot(self.recorded_periods, self.reference_periods)
     }
 
     /// The recorded period (0-based) a row starting `start_step` steps after `t0` belongs to.
@@ -317,6 +316,19 @@ impl RecordingInfo {
 
 fn is_zero(x: &u32) -> bool {
     *x == 0
+}
+
+/// Index of the last snapshot of a run's own: `tP` (`recorded_periods` = P) or the last
+/// reference snapshot `t_{K+1}` (`reference_periods` = K), whichever is later; the run stores
+/// `t0` to it, the recorded snapshots counting as references.
+pub fn last_snapshot(recorded_periods: u32, reference_periods: u32) -> u32 {
+    recorded_periods.max(reference_periods.saturating_add(1))
+}
+
+/// Reference periods the run simulates after its recorded ones (from `tP` to `t_{K+1}`;
+/// none when the recorded stretch already reaches the last reference snapshot).
+pub fn periods_after_recorded(recorded_periods: u32, reference_periods: u32) -> u32 {
+    last_snapshot(recorded_periods, reference_periods) - recorded_periods
 }
 
 fn one() -> u32 {

@@ -283,7 +283,7 @@ impl Checkpoint<'static> {
         );
         let recorded = o.recorded_periods;
         // the run's own snapshots: t0 up to tP or to the last reference t_(K+1)
-        let own = recorded.max(o.reference_periods.saturating_add(1)) as usize + 1;
+        let own = o.last_snapshot() as usize + 1;
         let (stage_ok, snapshots) = match self.stage {
             Stage::Settle { done } => (done <= settle, None),
             Stage::SpinUp { done } => (done <= spin, None),

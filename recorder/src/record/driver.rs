@@ -463,10 +463,7 @@ fn drive(
                 Ok::<_, RecordError>(())
             })?;
             // the run's own snapshots left, then each twin's, in the order they were written
-            let own = opts
-                .recorded_periods
-                .max(opts.reference_periods.saturating_add(1)) as usize
-                + 1;
+            let own = opts.last_snapshot() as usize + 1;
             for (k, snapshot) in out.snapshots.iter().enumerate().skip(next) {
                 match k.checked_sub(own) {
                     None => writer.write_snapshot(snapshot)?,

@@ -25,6 +25,13 @@ pub struct RecordOptions {
     pub area_encoding: AreaEncoding,
 }
 
+impl RecordOptions {
+    /// Index of the run's last own snapshot ([`tdex_format::last_snapshot`]).
+    pub fn last_snapshot(&self) -> u32 {
+        tdex_format::last_snapshot(self.recorded_periods, self.reference_periods)
+    }
+}
+
 /// The stage a progress report belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
