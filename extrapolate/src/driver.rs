@@ -122,9 +122,7 @@ pub fn extrapolate_recording(
                     used,
                 });
             }
-            let mut targets = targets.clone();
-            targets.sort_unstable();
-            targets.dedup();
+            let targets = path::distinct_ascending(targets);
             // every period as a target is the default path: nothing to record
             (!targets.is_empty() && targets.len() < used as usize).then_some(targets)
         }
@@ -298,14 +296,16 @@ pub fn extrapolate_recording(
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
     let mut exchanges = Exchanges::default();
-    // the output snapshot: t_p's positions, radii and velocities, the extrapolated
-    // temperatures, and as `id` the particle that plays each role (it moves with its heat,
-    // at the jumps only)
+    // the output snapshot: t_p's positions and velocities (radii are per particle, the same
+    // at every t_p), the extrapolated temperatures, and as `id` the particle that plays each
+    // role (it moves with its heat, at the jumps only)
     let mut out = if used == 1 {
         snaps.pop().expect("t0 and t1")
     } else {
         snaps[1].clone()
     };
+    // the recorded period whose end the output's positions are
+    let mut positions_of = 1;
     let mut next_id = Vec::with_capacity(out.id.len());
     let t = Instant::now();
     for (k, step) in (1..=request.periods).zip(&steps) {
@@ -343,11 +343,11 @@ pub fn extrapolate_recording(
             }
         }
         scratch.flush(&mut temps);
-        if used > 1 {
+        if p != positions_of {
             let end = &snaps[p as usize];
             out.pos.copy_from_slice(&end.pos);
-            out.radius.copy_from_slice(&end.radius);
             out.vel.copy_from_slice(&end.vel);
+            positions_of = p;
         }
         out.index = k + 1;
         out.time = info.snapshot_time(k + 1);
@@ -355,11 +355,7 @@ pub fn extrapolate_recording(
         writer.write_snapshot(&out)?;
     }
     let seconds_replay = t.elapsed().as_secs_f64();
-    let rows_replayed: u64 = if used == 1 {
-        rows * u64::from(request.periods)
-    } else {
-        steps.iter().map(|s| rows_of[s.period() as usize - 1]).sum()
-    };
+    let rows_replayed: u64 = steps.iter().map(|s| rows_of[s.period() as usize - 1]).sum();
     let costs = ExtrapolationCosts {
         seconds_pairing,
         pairing_reused: reused,

@@ -56,9 +56,7 @@ impl RecurrencePolicy {
     /// path is [`RecurrencePolicy::new`]'s, draw for draw.
     pub fn with_targets(recorded_periods: u32, seed: u64, targets: &[u32]) -> Self {
         let mut policy = Self::new(recorded_periods, seed);
-        let mut targets = targets.to_vec();
-        targets.sort_unstable();
-        targets.dedup();
+        let targets = distinct_ascending(targets);
         debug_assert!(targets
             .iter()
             .all(|t| (1..=policy.recorded_periods).contains(t)));
@@ -109,19 +107,25 @@ impl Iterator for RecurrencePolicy {
     }
 }
 
+/// `periods` each once, in increasing order.
+pub fn distinct_ascending(periods: &[u32]) -> Vec<u32> {
+    let mut periods = periods.to_vec();
+    periods.sort_unstable();
+    periods.dedup();
+    periods
+}
+
 /// The starts (1-based periods) the path jumps to, each once, in increasing order: the
 /// pairings it needs.
 pub fn starts(steps: &[Step]) -> Vec<u32> {
-    let mut starts: Vec<u32> = steps
+    let jumps: Vec<u32> = steps
         .iter()
         .filter_map(|s| match s {
             Step::Jump { period } => Some(*period),
             Step::Continue { .. } => None,
         })
         .collect();
-    starts.sort_unstable();
-    starts.dedup();
-    starts
+    distinct_ascending(&jumps)
 }
 
 #[cfg(test)]
