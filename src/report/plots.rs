@@ -266,7 +266,10 @@ fn runs<'a, 'b: 'a>(
 
 /// The legend box in the corner (or the middle of a side) of the plot that the `series`
 /// (each a line through its points) cross least.
-fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>, series: &[&[(f64, f64)]]) -> Result<()> {
+pub(crate) fn legend<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    series: &[&[(f64, f64)]],
+) -> Result<()> {
     let (x, y) = (chart.x_range(), chart.y_range());
     let (w, h) = (x.end - x.start, y.end - y.start);
     // boxes of 45 % of the width and 30 % of the height, in order of preference: the

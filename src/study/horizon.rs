@@ -9,7 +9,7 @@
 
 use super::plots::{self, Line, LineKind};
 use crate::cli::{HorizonSource, StudyPlan};
-use crate::compare::{self, Comparison};
+use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
 use extrapolate::replay::Scheme;
@@ -304,65 +304,51 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
         .first()
         .is_some_and(|e| e.comparison.hot_particles > 0);
     let mut mean_lines = Vec::new();
-    if let Some(first) = s.runs.first() {
-        let c = &first.comparison;
-        let runs = std::iter::once(&c.dem_series).chain(&c.dem_runs_series);
-        for (m, series) in runs.enumerate() {
-            let (name, kind) = if m == 0 {
-                ("DEM".to_string(), LineKind::Dem)
-            } else {
-                (format!("DEM twin {m}"), LineKind::DemRun)
-            };
-            if groups {
-                for (which, pick) in [("hot", true), ("cold", false)] {
-                    mean_lines.push(Line {
-                        kind,
-                        label: format!("{name}, {which}"),
-                        points: series
-                            .iter()
-                            .filter_map(|g| Some((g.t, if pick { g.hot? } else { g.cold? })))
-                            .collect(),
-                    });
-                }
-            } else {
+    let mut push_means = |name: String, kind: LineKind, series: &[GroupMeans]| {
+        if groups {
+            for (which, hot) in [("hot", true), ("cold", false)] {
                 mean_lines.push(Line {
                     kind,
-                    label: format!("{name}, bed"),
-                    points: series.iter().map(|g| (g.t, g.bed)).collect(),
-                });
-            }
-        }
-    }
-    for (n, e) in s.runs.iter().enumerate() {
-        let periods = &e.comparison.periods;
-        let label = format!("extrapolated, P = {}", e.recorded_periods);
-        if groups {
-            for (which, pick) in [("hot", true), ("cold", false)] {
-                mean_lines.push(Line {
-                    kind: LineKind::Extrapolation(n),
-                    label: format!("{label}, {which}"),
-                    points: periods
+                    label: format!("{name}, {which}"),
+                    points: series
                         .iter()
-                        .filter_map(|p| {
-                            Some((
-                                p.t,
-                                if pick {
-                                    p.hot_mean_extra?
-                                } else {
-                                    p.cold_mean_extra?
-                                },
-                            ))
-                        })
+                        .filter_map(|g| Some((g.t, if hot { g.hot? } else { g.cold? })))
                         .collect(),
                 });
             }
         } else {
             mean_lines.push(Line {
-                kind: LineKind::Extrapolation(n),
-                label: format!("{label}, bed"),
-                points: periods.iter().map(|p| (p.t, p.bed_mean_extra)).collect(),
+                kind,
+                label: format!("{name}, bed"),
+                points: series.iter().map(|g| (g.t, g.bed)).collect(),
             });
         }
+    };
+    if let Some(first) = s.runs.first() {
+        let c = &first.comparison;
+        push_means("DEM".into(), LineKind::Dem, &c.dem_series);
+        for (m, twin) in c.dem_runs_series.iter().enumerate() {
+            push_means(format!("DEM twin {}", m + 1), LineKind::DemRun, twin);
+        }
+    }
+    for (n, e) in s.runs.iter().enumerate() {
+        let extrapolated: Vec<GroupMeans> = e
+            .comparison
+            .periods
+            .iter()
+            .map(|p| GroupMeans {
+                k: p.k,
+                t: p.t,
+                hot: p.hot_mean_extra,
+                cold: p.cold_mean_extra,
+                bed: p.bed_mean_extra,
+            })
+            .collect();
+        push_means(
+            format!("extrapolated, P = {}", e.recorded_periods),
+            LineKind::Extrapolation(n),
+            &extrapolated,
+        );
     }
     let means = plots::lines(
         if groups {

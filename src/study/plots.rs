@@ -2,7 +2,9 @@
 //! `<text>`, 820×520, sans-serif; the same inputs give the same bytes), with its axis
 //! helpers.
 
-use crate::report::plots::{axes, chart, message, render, span, tick, COLD, FONT, GREY, HOT, SIZE};
+use crate::report::plots::{
+    axes, chart, legend, message, render, span, tick, COLD, FONT, GREY, HOT, SIZE,
+};
 use anyhow::Result;
 use plotters::prelude::*;
 
@@ -182,13 +184,9 @@ pub fn lines(
                     PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
                 });
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(GREY)
-            .label_font((FONT, 13))
-            .position(SeriesLabelPosition::UpperLeft)
-            .draw()?;
+        // the legend where the lines cross least, as in the report's plots
+        let crossed: Vec<&[(f64, f64)]> = series.iter().map(|s| &s.points[..]).collect();
+        legend(&mut chart, &crossed)?;
         Ok(())
     })
 }
