@@ -4,6 +4,7 @@
 use super::FormatError;
 use memmap2::Mmap;
 use std::fs::File;
+use std::ops::RangeInclusive;
 use std::path::{Path, PathBuf};
 
 const MAGIC: &[u8] = b"\x89MCAP0\r\n";
@@ -188,11 +189,12 @@ impl McapFile {
             .ok_or_else(|| self.not_ours(format!("no channel '{topic}' with schema '{schema}'")))
     }
 
-    /// Chunks holding messages of `channel` (logged at `time`, ns, if given), in file order.
+    /// Chunks holding messages of `channel` (some logged within `times`, ns, if given), in
+    /// file order.
     pub(crate) fn chunks_of_at(
         &self,
         channel: u16,
-        time: Option<u64>,
+        times: Option<RangeInclusive<u64>>,
     ) -> impl Iterator<Item = &mcap::records::ChunkIndex> {
         let mut chunks: Vec<_> = self
             .summary
@@ -200,22 +202,24 @@ impl McapFile {
             .iter()
             .filter(|ci| ci.message_index_offsets.contains_key(&channel))
             .filter(|ci| {
-                time.is_none_or(|t| (ci.message_start_time..=ci.message_end_time).contains(&t))
+                times.as_ref().is_none_or(|t| {
+                    ci.message_start_time <= *t.end() && ci.message_end_time >= *t.start()
+                })
             })
             .collect();
         chunks.sort_by_key(|ci| ci.chunk_start_offset);
         chunks.into_iter()
     }
 
-    /// Messages of `channel` (in the chunks that hold messages logged at `time`, ns, if
+    /// Messages of `channel` (in the chunks that hold messages logged within `times`, ns, if
     /// given), decompressing one chunk at a time: `(sequence, data)`. A chunk's messages are
     /// handed out only after its CRC has been checked, so damaged data is never decoded.
     pub(crate) fn messages_at(
         &self,
         channel: u16,
-        time: Option<u64>,
+        times: Option<RangeInclusive<u64>>,
     ) -> impl Iterator<Item = Result<(u32, Vec<u8>), FormatError>> + '_ {
-        self.chunks_of_at(channel, time).flat_map(move |ci| {
+        self.chunks_of_at(channel, times).flat_map(move |ci| {
             let batch: Vec<Result<(u32, Vec<u8>), FormatError>> =
                 match self.chunk_messages(ci, channel) {
                     Ok(messages) => messages.into_iter().map(Ok).collect(),

@@ -198,7 +198,10 @@ impl RecordingReader {
     /// The snapshot with this index, if stored; only its own chunk is read and decoded.
     pub fn snapshot(&self, index: u32) -> Result<Option<Snapshot>, FormatError> {
         let time = log_time(self.info.snapshot_time(index));
-        for m in self.file.messages_at(self.snapshot_channel, Some(time)) {
+        for m in self
+            .file
+            .messages_at(self.snapshot_channel, Some(time..=time))
+        {
             let (sequence, data) = m?;
             if sequence == index {
                 return self.decode_snapshot(index, &data).map(Some);
@@ -208,64 +211,81 @@ impl RecordingReader {
     }
 
     /// The rows of recorded period `period` (0-based), batch by batch in apparition order,
-    /// start steps still counted from `t0`. The batches of the other periods are decoded and
-    /// skipped (a batch never spans two periods).
+    /// start steps still counted from `t0`. Only the chunks logged within the period are
+    /// read (a batch is logged at its first row's start); a chunk that also holds batches of
+    /// a neighbouring period has those decoded and skipped (a batch never spans two periods).
     pub fn period_table(
         &self,
         period: u32,
     ) -> impl Iterator<Item = Result<TableBatch, FormatError>> + '_ {
+        let info = &self.info;
+        let start = |p: u64| log_time((info.step_t0 + p * info.period_steps) as f64 * info.dt);
+        // one nanosecond of margin on each side: the window only chooses chunks to read, the
+        // rows' start steps decide
+        let window = start(period as u64).saturating_sub(1)..=start(period as u64 + 1) + 1;
         let period = period as u64;
-        self.table().filter_map(move |batch| {
-            let batch = match batch {
-                Ok(batch) => batch,
-                Err(e) => return Some(Err(e)),
-            };
-            let of = |r: &CollisionRow| self.info.period_of_step(r.start_step);
-            let (first, last) = (batch.rows.first()?, batch.rows.last()?);
-            if of(first) != of(last) {
-                return Some(Err(self.corrupt(format!(
-                    "batch at row {} spans recorded periods {} to {} (a batch holds one period's rows)",
-                    batch.first_row,
-                    of(first),
-                    of(last)
-                ))));
-            }
-            if of(first) >= self.info.recorded_periods as u64 {
-                return Some(Err(self.corrupt(format!(
-                    "row {}: start step {} is past the {} recorded period(s) of {} steps",
-                    batch.first_row, first.start_step, self.info.recorded_periods, self.info.period_steps
-                ))));
-            }
-            (of(first) == period).then_some(Ok(batch))
-        })
+        self.batches(self.file.messages_at(self.collision_channel, Some(window)), None)
+            .filter_map(move |batch| {
+                let batch = match batch {
+                    Ok(batch) => batch,
+                    Err(e) => return Some(Err(e)),
+                };
+                let of = |r: &CollisionRow| self.info.period_of_step(r.start_step);
+                let (first, last) = (batch.rows.first()?, batch.rows.last()?);
+                if of(first) != of(last) {
+                    return Some(Err(self.corrupt(format!(
+                        "batch at row {} spans recorded periods {} to {} (a batch holds one period's rows)",
+                        batch.first_row,
+                        of(first),
+                        of(last)
+                    ))));
+                }
+                if of(first) >= self.info.recorded_periods as u64 {
+                    return Some(Err(self.corrupt(format!(
+                        "row {}: start step {} is past the {} recorded period(s) of {} steps",
+                        batch.first_row, first.start_step, self.info.recorded_periods, self.info.period_steps
+                    ))));
+                }
+                (of(first) == period).then_some(Ok(batch))
+            })
     }
 
     /// The table, batch by batch in apparition order; memory holds one chunk and one batch.
     pub fn table(&self) -> impl Iterator<Item = Result<TableBatch, FormatError>> + '_ {
-        let mut next_row = 0u64;
+        self.batches(self.file.messages_at(self.collision_channel, None), Some(0))
+    }
+
+    /// The table batches of `messages`, decoded and checked: consecutive rows (the first at
+    /// row `first_row`, or wherever the first batch says when the messages start inside the
+    /// table) and start steps in apparition order.
+    fn batches<'a>(
+        &'a self,
+        messages: impl Iterator<Item = Result<(u32, Vec<u8>), FormatError>> + 'a,
+        first_row: Option<u64>,
+    ) -> impl Iterator<Item = Result<TableBatch, FormatError>> + 'a {
+        let mut next_row = first_row;
         let mut last_start = 0u64;
-        self.file
-            .messages_at(self.collision_channel, None)
-            .map(move |m| {
-                let (_, data) = m?;
-                let batch = table::decode(&data, &self.info).map_err(|e| self.corrupt(e))?;
-                if batch.first_row != next_row {
+        messages.map(move |m| {
+            let (_, data) = m?;
+            let batch = table::decode(&data, &self.info).map_err(|e| self.corrupt(e))?;
+            let expected = *next_row.get_or_insert(batch.first_row);
+            if batch.first_row != expected {
+                return Err(self.corrupt(format!(
+                    "batch starts at row {} where row {expected} was expected",
+                    batch.first_row
+                )));
+            }
+            if let Some(first) = batch.rows.first() {
+                if first.start_step < last_start {
                     return Err(self.corrupt(format!(
-                        "batch starts at row {} where row {next_row} was expected",
-                        batch.first_row
+                        "row {}: start step {} before the previous row's {last_start}",
+                        batch.first_row, first.start_step
                     )));
                 }
-                if let Some(first) = batch.rows.first() {
-                    if first.start_step < last_start {
-                        return Err(self.corrupt(format!(
-                            "row {}: start step {} before the previous row's {last_start}",
-                            batch.first_row, first.start_step
-                        )));
-                    }
-                }
-                next_row += batch.rows.len() as u64;
-                last_start = batch.rows.last().map_or(last_start, |r| r.start_step);
-                Ok(batch)
-            })
+            }
+            next_row = Some(expected + batch.rows.len() as u64);
+            last_start = batch.rows.last().map_or(last_start, |r| r.start_step);
+            Ok(batch)
+        })
     }
 }
