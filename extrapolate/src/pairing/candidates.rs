@@ -63,6 +63,31 @@ pub(crate) fn knn(
     (cols, costs)
 }
 
+/// Mean cost from every t1 point to the t0 point nearest to its query centre: an upper
+/// bound of the mean cheapest cost of any kNN graph built on those centres (that point is
+/// always among a row's candidates), at a fraction of the cost of the graph.
+pub(crate) fn mean_nearest_cost(
+    tree: &Tree,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    centres: &[[f64; 3]],
+    scale: &CostScale,
+) -> f64 {
+    let sum: i128 = centres
+        .par_iter()
+        .zip(x1)
+        .with_min_len(256)
+        .map(|(c, p)| {
+            let hit = tree
+                .query(c)
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .execute();
+            scale.cost(p, &x0[hit.item as usize]) as i128
+        })
+        .sum();
+    sum as f64 / x1.len().max(1) as f64
+}
+
 /// Half-width, in ranks, of the window over which the axial transport estimate of
 /// [`Axial`] is averaged.
 const AXIAL_WINDOW: usize = 64;
@@ -263,5 +288,39 @@ mod tests {
         assert_eq!(g.row(1).1[4], 43000);
         assert_eq!(g.edges(), 8);
         assert_eq!(g.rows(), 2);
+    }
+
+    /// The shortcut of `sparse` relies on this bound: the t0 point nearest to a row's
+    /// centre is one of its candidates, so the mean cheapest candidate cost never exceeds
+    /// the mean cost to it, whatever k and however far the centres are moved.
+    #[test]
+    fn the_nearest_cost_bounds_the_mean_cheapest_candidate() {
+        let lattice = |shift: f64| -> Vec<[f64; 3]> {
+            (0..400)
+                .map(|i| {
+                    let (a, b, c) = ((i % 7) as f64, ((i / 7) % 7) as f64, (i / 49) as f64);
+                    [
+                        a + 0.31 * (i % 3) as f64,
+                        b + shift,
+                        c + 0.17 * (i % 5) as f64,
+                    ]
+                })
+                .collect()
+        };
+        let (x0, x1) = (lattice(0.0), lattice(0.6));
+        let scale = CostScale::new(&x0, &x1, 1e-3).unwrap();
+        let tree = build_tree(&x0);
+        for centres in [x1.clone(), lattice(-1.4)] {
+            let bound = mean_nearest_cost(&tree, &x0, &x1, &centres, &scale);
+            for k in [1, 4, 24] {
+                let (c, w) = knn(&tree, &x0, &x1, &centres, k, &scale);
+                let g = Graph::build(k, &c, &w, &[], &x0, &x1, &scale);
+                let cheapest = crate::pairing::sparse_lap::mean_cheapest(&g);
+                assert!(cheapest <= bound, "k {k}: {cheapest} > {bound}");
+                if k == 1 {
+                    assert_eq!(cheapest, bound, "k = 1: the nearest point is the only one");
+                }
+            }
+        }
     }
 }

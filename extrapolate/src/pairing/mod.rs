@@ -365,21 +365,31 @@ fn sparse(
     // axis (`candidates::Axial`; docs/pairing.md, "Long drums").
     let axial = candidates::Axial::new(x0, x1);
     let centres = axial.centres(x1);
-    let mut k0 = opts.k_initial.min(n);
+    let shift = axial.mean_abs_shift();
+    // A bed with a large axial transport needs more candidates: the long kiln has no
+    // perfect matching at k = 24, and finding that out costs the auction's whole budget
+    // (docs/pairing.md, "Long drums"). The test is `shift > ρ`, with ρ the mean cheapest
+    // candidate cost of the k-graph; the mean cost to each centre's nearest t0 point
+    // bounds ρ from above, so when the shift exceeds even that bound the k-graph (0.3 s
+    // at 80 000 particles) need not be built just to be thrown away. Same decision, same
+    // graph, same result.
+    let k_axial = (opts.k_initial * AXIAL_K_NUM / AXIAL_K_DEN).clamp(1, n);
+    let nearest = candidates::mean_nearest_cost(&tree, x0, x1, &centres, scale) * scale.unit();
+    let mut k0 = if shift > nearest {
+        k_axial
+    } else {
+        opts.k_initial.min(n)
+    };
     let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
     let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
     let mut rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
-    let shift = axial.mean_abs_shift();
     trace!(
         t,
-        "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}) + knn k {k0} + graph"
+        "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, nearest bound {nearest:.3e}) + knn k {k0} + graph"
     );
-    // A bed with a large axial transport needs more candidates: the paper's drum has
-    // no perfect matching at k = 24, and finding that out costs the auction's whole
-    // budget (docs/pairing.md, "Long drums").
-    if shift > rho && k0 < n {
-        k0 = (k0 * AXIAL_K_NUM / AXIAL_K_DEN).clamp(1, n);
+    if k0 < k_axial && shift > rho {
+        k0 = k_axial;
         (kc, kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
         graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
         rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
