@@ -274,7 +274,7 @@ fn extrapolate(rec: &Path, out: &Path, periods: &str, extra: &[&str]) -> serde_j
 /// period; the path is a function of the seed; `tdex pair` stores one pairing per start.
 #[test]
 fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
-    use extrapolate::replay::{self, Bodies, Scheme, SyncScratch, Table};
+    use extrapolate::replay::{self, Bodies, Scheme, Table};
     let dir = tempfile::tempdir().unwrap();
     let case = setup(dir.path());
     let (p3, p1) = (dir.path().join("p3.mcap"), dir.path().join("p1.mcap"));
@@ -303,18 +303,10 @@ fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
         out[0].temp, temps,
         "the extrapolation starts from the DEM at t1"
     );
-    let mut scratch = SyncScratch::default();
     for k in [2usize, 3] {
         let rows = rec.summary().unwrap().period_rows[k - 1];
         let (table, _) = Table::read_period(&rec, &bodies, k as u32, rows).unwrap();
-        replay::apply_rows_with(
-            &mut temps,
-            &table.exchanges,
-            &bodies,
-            Scheme::Explicit,
-            &mut scratch,
-        );
-        scratch.flush(&mut temps);
+        replay::apply_rows(&mut temps, &table.exchanges, &bodies, Scheme::Explicit);
         let at = &out[k - 1];
         assert_eq!(at.index as usize, k);
         assert_eq!(at.pos, dem[k].pos, "t{k}: the DEM's own positions");

@@ -5,7 +5,8 @@
 use crate::cache;
 use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
-    self, Bodies, CflRow, Exchanges, MemoryNeeds, MemoryPlan, Scheme, SyncScratch, Table, TableMode,
+    self, Bodies, CflRow, Exchanges, MemoryNeeds, MemoryPlan, RoleTemperatures, Scheme,
+    SyncScratch, Table, TableMode,
 };
 use crate::sidecar::{PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
@@ -291,8 +292,8 @@ pub fn extrapolate_recording(
 
     // role a ends recorded period p at x_a(t_p): the snapshot's positions, radii and
     // velocities
-    let mut temps = snaps[1].temp.clone();
-    let heat_t1 = replay::total_heat(&temps, &bodies);
+    let heat_t1 = replay::total_heat(&snaps[1].temp, &bodies);
+    let mut temps = RoleTemperatures::new(&snaps[1].temp, &bodies);
     let mut next = Vec::with_capacity(temps.len());
     let mut scratch = SyncScratch::default();
     let mut exchanges = Exchanges::default();
@@ -312,8 +313,7 @@ pub fn extrapolate_recording(
         let p = step.period();
         if let Step::Jump { period } = *step {
             let g = pairing_of(period);
-            replay::move_to_roles(&temps, g, &mut next)?;
-            std::mem::swap(&mut temps, &mut next);
+            temps.move_to_roles(g, &mut next)?;
             replay::move_to_roles(&out.id, g, &mut next_id)?;
             std::mem::swap(&mut out.id, &mut next_id);
         }
@@ -351,7 +351,7 @@ pub fn extrapolate_recording(
         }
         out.index = k + 1;
         out.time = info.snapshot_time(k + 1);
-        out.temp.copy_from_slice(&temps);
+        temps.write_to(&mut out.temp);
         writer.write_snapshot(&out)?;
     }
     let seconds_replay = t.elapsed().as_secs_f64();
@@ -375,7 +375,7 @@ pub fn extrapolate_recording(
         roles: path_of(&|s: &StoredPairing| s.summary.clone()),
         costs,
         total_heat_t1: heat_t1,
-        total_heat_end: replay::total_heat(&temps, &bodies),
+        total_heat_end: temps.total_heat(&bodies),
     })
 }
 

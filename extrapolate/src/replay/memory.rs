@@ -21,11 +21,11 @@ pub const ROW_BYTES: u64 = std::mem::size_of::<Exchange>() as u64;
 const POINT_BYTES: u64 = 68;
 
 /// Per particle, whatever the table: the `t0` and `t1` snapshots (2 points), the role
-/// temperatures and their next copy (16), the output's ids and their next copy (8), the
-/// capacities and their inverses (16), the pairing and its stored JSON text (16), the
-/// synchronous scheme's deltas (8), and one snapshot in transit: encoded, then in the
-/// writer's chunk (or, when read, a decompressed chunk and its message copy): 3 points.
-pub const PARTICLE_BYTES: u64 = 2 * POINT_BYTES + 16 + 8 + 16 + 16 + 8 + 3 * POINT_BYTES;
+/// temperatures beside their `1/C` and the temperatures' next copy (16 + 8), the output's
+/// ids and their next copy (8), the capacities (8), the pairing and its stored JSON text
+/// (16), the synchronous scheme's deltas (8), and one snapshot in transit: encoded, then in
+/// the writer's chunk (or, when read, a decompressed chunk and its message copy): 3 points.
+pub const PARTICLE_BYTES: u64 = 2 * POINT_BYTES + 24 + 8 + 8 + 16 + 8 + 3 * POINT_BYTES;
 
 /// Per particle and per recorded period of a recurrence path (`P' > 1`): the `P' − 1` end
 /// snapshots beyond `t1`, whose positions, radii and velocities the output carries, and the

@@ -3,10 +3,12 @@
 //! boundary, and every row exchanges heat between its two bodies.
 
 pub mod memory;
+mod roles;
 mod schemes;
 mod table;
 
 pub use memory::{MemoryNeeds, MemoryPlan, ModeReason, TableMode};
+pub use roles::RoleTemperatures;
 pub use schemes::{apply_rows, apply_rows_with, Scheme, SyncScratch};
 pub use table::{
     period_batches, scan, scan_period, Bodies, CflRow, Exchange, Exchanges, StartRun, Table,
@@ -73,21 +75,35 @@ pub fn move_to_roles<T: Copy + Default>(
     g: &[u32],
     next: &mut Vec<T>,
 ) -> Result<(), ReplayError> {
-    if g.len() != temps.len() {
+    move_each_to_roles(temps.iter().copied(), g, next)
+}
+
+/// [`move_to_roles`] of the values `held`, one per role in role order.
+fn move_each_to_roles<T: Copy + Default>(
+    held: impl ExactSizeIterator<Item = T>,
+    g: &[u32],
+    next: &mut Vec<T>,
+) -> Result<(), ReplayError> {
+    if g.len() != held.len() {
         return Err(ReplayError::Roles {
             got: g.len(),
-            expected: temps.len(),
+            expected: held.len(),
         });
     }
     next.clear();
-    next.resize(temps.len(), T::default());
-    for (a, &t) in temps.iter().enumerate() {
-        next[g[a] as usize] = t;
+    next.resize(g.len(), T::default());
+    for (t, &to) in held.zip(g) {
+        next[to as usize] = t;
     }
     Ok(())
 }
 
 /// `Σ C T` over the particles (J).
 pub fn total_heat(temps: &[f64], bodies: &Bodies) -> f64 {
-    temps.iter().zip(&bodies.capacity).map(|(t, c)| t * c).sum()
+    heat(temps.iter().copied(), bodies)
+}
+
+/// [`total_heat`] of the temperatures `temps`, one per particle in order.
+fn heat(temps: impl Iterator<Item = f64>, bodies: &Bodies) -> f64 {
+    temps.zip(bodies.capacity()).map(|(t, c)| t * c).sum()
 }

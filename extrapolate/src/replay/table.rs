@@ -95,13 +95,32 @@ fn start_in_period(row: &CollisionRow, offset: u64) -> u32 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bodies {
     /// `C = ρ c (4/3)π r³` of each particle (J/K).
-    pub capacity: Vec<f64>,
-    pub inverse_capacity: Vec<f64>,
+    capacity: Vec<f64>,
+    /// `1/C` when it is the same value bit for bit for every particle (a monodisperse bed,
+    /// the usual DEM case): the replay's loops then use this constant instead of reading
+    /// each role's own.
+    uniform_inverse_capacity: Option<f64>,
     /// Fixed temperature of wall `w` (body `particles + w`), `None` if adiabatic.
-    pub wall_temperature: Vec<Option<f64>>,
+    wall_temperature: Vec<Option<f64>>,
 }
 
 impl Bodies {
+    /// Particles of heat capacities `capacity` (J/K) and walls at `wall_temperature` (`None`
+    /// if adiabatic).
+    pub fn new(capacity: Vec<f64>, wall_temperature: Vec<Option<f64>>) -> Self {
+        let first = capacity.first().map(|&c| inverse(c));
+        let uniform_inverse_capacity = first.filter(|first| {
+            capacity
+                .iter()
+                .all(|&c| inverse(c).to_bits() == first.to_bits())
+        });
+        Self {
+            capacity,
+            uniform_inverse_capacity,
+            wall_temperature,
+        }
+    }
+
     /// The bodies of a recording, with the particle radii of its `t0` snapshot.
     pub fn of(info: &RecordingInfo, t0: &Snapshot) -> Self {
         let capacity: Vec<f64> = t0
@@ -111,26 +130,53 @@ impl Bodies {
                 info.density * info.heat_capacity * (4.0 / 3.0) * std::f64::consts::PI * r * r * r
             })
             .collect();
-        Self {
-            inverse_capacity: capacity.iter().map(|c| 1.0 / c).collect(),
-            capacity,
-            wall_temperature: info.walls.iter().map(|w| w.temperature).collect(),
-        }
+        Self::new(capacity, info.walls.iter().map(|w| w.temperature).collect())
     }
 
     pub fn particles(&self) -> usize {
         self.capacity.len()
     }
 
+    /// `C` of each particle (J/K).
+    pub fn capacity(&self) -> &[f64] {
+        &self.capacity
+    }
+
+    /// `1/C` of particle `k` (K/J): not stored (the replay keeps it beside each role's
+    /// temperature), computed, or the uniform one of a monodisperse bed.
+    ///
+    /// # Panics
+    /// If `k` is not a particle.
+    pub fn inverse_capacity(&self, k: usize) -> f64 {
+        let capacity = self.capacity[k];
+        self.uniform_inverse_capacity
+            .unwrap_or_else(|| inverse(capacity))
+    }
+
+    /// The one `1/C` of every particle, if they all have the same bits.
+    pub fn uniform_inverse_capacity(&self) -> Option<f64> {
+        self.uniform_inverse_capacity
+    }
+
+    /// Fixed temperature of wall `w` (body `particles + w`), `None` if adiabatic.
+    pub fn wall_temperature(&self, w: usize) -> Option<f64> {
+        self.wall_temperature[w]
+    }
+
     /// The row's CFL number `c = H m (1/C_k + 1/C_l)` (a wall's capacity is infinite).
     pub fn cfl(&self, e: &Exchange) -> f64 {
-        let inverse_l = self
-            .inverse_capacity
-            .get(e.j as usize)
-            .copied()
-            .unwrap_or(0.0);
-        e.conductance_time * (self.inverse_capacity[e.i as usize] + inverse_l)
+        let inverse_l = if (e.j as usize) < self.particles() {
+            self.inverse_capacity(e.j as usize)
+        } else {
+            0.0
+        };
+        e.conductance_time * (self.inverse_capacity(e.i as usize) + inverse_l)
     }
+}
+
+/// `1/C`, computed one way wherever it is needed (the same bits each time).
+fn inverse(capacity: f64) -> f64 {
+    1.0 / capacity
 }
 
 impl Exchange {
