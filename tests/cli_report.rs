@@ -225,6 +225,8 @@ fn report_writes_valid_svgs_and_resolving_links() {
     );
     assert_eq!(table_row(&md, "Pairing (s)")[0], 0.0);
     assert_eq!(table_row(&md, "Collision file (s)")[0], 0.0);
+    let reading = table_row(&md, "Reading the table (s)");
+    assert!(reading[0] == 0.0 && reading[1] >= 0.0, "{reading:?}");
     let per_tau = table_row(&md, "For one τ (s)");
     assert!(per_tau.iter().all(|s| *s > 0.0), "{per_tau:?}");
     let total = table_row(&md, "Total for 100 τ (s)");
