@@ -48,14 +48,18 @@ impl CostTable {
     /// pairing summary's `seconds` (the cost of computing it, also when it was reused); when
     /// absent the extrapolation's own `seconds_pairing` is used. `recorded_periods` is the
     /// recording's P: its reference stage ran the `K + 1 − P` periods after `tP`.
+    /// `periods_used` is the P' ≤ P the extrapolation replayed (`--recorded-periods`): only
+    /// those periods are charged to it.
     pub fn new(
         recording: &RecordingCosts,
         reference_periods: u32,
         recorded_periods: u32,
+        periods_used: u32,
         extrapolation: &ExtrapolationCosts,
         pairing_seconds: Option<f64>,
     ) -> Self {
         let recorded_periods = recorded_periods.max(1);
+        let periods_used = periods_used.clamp(1, recorded_periods);
         // the DEM's share of one recorded period (the recorder ran beside it)
         let dem_period =
             (recording.seconds_period - recording.seconds_recorder) / recorded_periods as f64;
@@ -77,7 +81,7 @@ impl CostTable {
                 .filter(|s| s.is_finite() && *s >= 0.0)
                 .unwrap_or(extrapolation.seconds_pairing),
             pairing_reused: extrapolation.pairing_reused,
-            collision_file: recording.seconds_period - dem_period,
+            collision_file: used_seconds(recording, recorded_periods, periods_used) - dem_period,
             read_table: extrapolation.seconds_read_table,
             tau_dem,
             tau_dem_source,
@@ -120,6 +124,19 @@ impl CostTable {
     }
 }
 
+/// Wall seconds of the first `used` of the recording's `recorded` periods, DEM and recorder:
+/// all of `seconds_period` when every period is used, else the periods' own times (or an
+/// even share when the recording kept none).
+fn used_seconds(recording: &RecordingCosts, recorded: u32, used: u32) -> f64 {
+    if used >= recorded {
+        return recording.seconds_period;
+    }
+    match recording.seconds_each_period.get(..used as usize) {
+        Some(each) if recording.seconds_each_period.len() == recorded as usize => each.iter().sum(),
+        _ => recording.seconds_period * used as f64 / recorded as f64,
+    }
+}
+
 fn ratio(a: f64, b: f64) -> Option<f64> {
     (b > 0.0 && a.is_finite() && b.is_finite()).then(|| a / b)
 }
@@ -151,7 +168,7 @@ mod tests {
             rows_per_second: 0.0,
             rows: 0,
         };
-        let t = CostTable::new(&recording, 0, 1, &extrapolation, Some(551.0));
+        let t = CostTable::new(&recording, 0, 1, 1, &extrapolation, Some(551.0));
         assert_eq!(t.until_t1, 8580.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::RecordedPeriod);
         assert_eq!(t.total_dem(100.0), 398_580.0);
@@ -164,7 +181,7 @@ mod tests {
             seconds_reference: 3.0 * 4000.0,
             ..recording
         };
-        let t = CostTable::new(&with_reference, 3, 1, &extrapolation, None);
+        let t = CostTable::new(&with_reference, 3, 1, 1, &extrapolation, None);
         assert_eq!(t.tau_dem, 4000.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::Reference { periods: 3 });
         assert_eq!(t.pairing, 0.0);
@@ -195,15 +212,21 @@ mod tests {
             rows: 0,
         };
         // K = 8 reference periods: t2…t9, of which t5…t9 ran after the recorded t0…t4
-        let t = CostTable::new(&recording, 8, 4, &extrapolation, None);
+        let t = CostTable::new(&recording, 8, 4, 4, &extrapolation, None);
         assert_eq!(t.until_t1, 150.0);
         assert_eq!(t.collision_file, 170.0);
         assert_eq!(t.tau_dem, 48.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::Reference { periods: 5 });
         // the reference inside the recorded stretch: the recorded periods give the DEM's τ
-        let t = CostTable::new(&recording, 3, 4, &extrapolation, None);
+        let t = CostTable::new(&recording, 3, 4, 4, &extrapolation, None);
         assert_eq!(t.tau_dem, 50.0);
         assert_eq!(t.tau_dem_source, DemPeriodSource::RecordedPeriod);
+        // an extrapolation that replays only the first two: the DEM to t1 as before, the
+        // second period (55 s) less the mean DEM share (50 s) counted in it, plus t1's 5 s
+        let t = CostTable::new(&recording, 8, 4, 2, &extrapolation, None);
+        assert_eq!(t.until_t1, 150.0);
+        assert_eq!(t.collision_file, 2.0 * 55.0 - 50.0);
+        assert_eq!(t.tau_dem, 48.0);
     }
 
     /// Reading the table into memory is paid once, before the first replayed period.
@@ -228,7 +251,7 @@ mod tests {
             rows_per_second: 0.0,
             rows: 0,
         };
-        let t = CostTable::new(&recording, 2, 1, &extrapolation, Some(1.0));
+        let t = CostTable::new(&recording, 2, 1, 1, &extrapolation, Some(1.0));
         assert_eq!(t.read_table, 9.0);
         // 150 to t1, then 1 + 10 + 9 once and 0.25 per period
         assert_eq!(t.total_extrapolated(100.0), 150.0 + 20.0 + 25.0);

@@ -162,6 +162,7 @@ pub fn write_with(
                 rc,
                 info.reference_periods,
                 info.recorded_periods,
+                extrapolation.info().roles.recorded_periods_used(),
                 ec,
                 pairing_seconds,
             ))

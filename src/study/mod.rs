@@ -146,6 +146,7 @@ pub fn evaluate(
             rc,
             info.reference_periods,
             info.recorded_periods,
+            ext.info().roles.recorded_periods_used(),
             ec,
             pairing,
         );

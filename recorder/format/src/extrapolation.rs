@@ -60,6 +60,14 @@ impl Roles {
                 .reduce(|a, b| a + b),
         }
     }
+
+    /// The recorded periods the extrapolation replayed, `P'` (1 through a pairing).
+    pub fn recorded_periods_used(&self) -> u32 {
+        match self {
+            Roles::Pairing(_) => 1,
+            Roles::Path(path) => path.recorded_periods,
+        }
+    }
 }
 
 /// The recurrence path an extrapolation of several recorded periods followed.
