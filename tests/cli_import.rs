@@ -551,20 +551,3 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
         );
     }
 }
-
-/// Whether `liggghts` can run; CI installs it and sets TDEX_REQUIRE_LIGGGHTS so that the
-/// LIGGGHTS test cannot pass by skipping.
-fn liggghts_available() -> bool {
-    let found = std::process::Command::new("sh")
-        .args(["-c", "command -v liggghts"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !found {
-        assert!(
-            std::env::var_os("TDEX_REQUIRE_LIGGGHTS").is_none(),
-            "liggghts is required (TDEX_REQUIRE_LIGGGHTS is set): apt-get install -y liggghts"
-        );
-        eprintln!("skipped: apt-get install -y liggghts to run it");
-    }
-    found
-}

@@ -3,6 +3,7 @@
 
 mod util;
 
+mod cli_bench;
 mod cli_case_errors;
 mod cli_checkpoint;
 mod cli_compare;

@@ -7,6 +7,7 @@ use anyhow::Result;
 use recorder::counters::Counters;
 use recorder::record;
 use serde::Serialize;
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Debug, Serialize)]
@@ -44,11 +45,12 @@ struct EngineBench {
     liggghts_dir: Option<String>,
 }
 
-/// Runs the case to `t0`, times `steps` steps after it, then (if asked) the LIGGGHTS peer.
+/// Runs the case to `t0`, times `steps` steps after it, then (if asked) the LIGGGHTS peer from
+/// the same bed at `t0`.
 pub fn engine(plan: &BenchPlan) -> Result<()> {
-    let mut result = crate::with_workers(plan.threads, || time_tdex(plan))?;
-    if let Some(dir) = &plan.liggghts {
-        let peer = liggghts::run(plan, dir.as_deref())?;
+    let (mut result, peer_dir) = crate::with_workers(plan.threads, || time_tdex(plan))?;
+    if let Some(dir) = peer_dir {
+        let peer = liggghts::run(plan, dir)?;
         result.liggghts_particle_steps_per_s = Some(peer.particle_steps_per_s);
         result.liggghts_seconds = Some(peer.seconds);
         result.ratio = Some(result.particle_steps_per_s / peer.particle_steps_per_s);
@@ -62,10 +64,16 @@ pub fn engine(plan: &BenchPlan) -> Result<()> {
     Ok(())
 }
 
-fn time_tdex(plan: &BenchPlan) -> Result<EngineBench> {
+/// The timed steps; and, when the LIGGGHTS peer is asked for, the directory where its deck and
+/// tdex's bed at `t0` were written.
+fn time_tdex(plan: &BenchPlan) -> Result<(EngineBench, Option<PathBuf>)> {
     let bar = crate::progress::dem_bar(plan.json, "tdex");
     let mut sim = record::run_to_t0(&plan.case, &mut crate::progress::on_phase(&bar))?;
     bar.finish_and_clear();
+    let peer_dir = match &plan.liggghts {
+        Some(dir) => Some(liggghts::prepare(plan, &sim.particles, dir.as_deref())?),
+        None => None,
+    };
     sim.counters = Counters::default();
     let rebuilds_before = sim.neighbors.rebuilds;
     let n = sim.particles.len();
@@ -91,7 +99,7 @@ fn time_tdex(plan: &BenchPlan) -> Result<EngineBench> {
         .collect();
     let per_step_particle = (plan.steps * n as u64) as f64;
     let peak = peak_resident_bytes();
-    Ok(EngineBench {
+    let bench = EngineBench {
         case: plan.case.name.clone(),
         particles: n,
         steps: plan.steps,
@@ -108,7 +116,8 @@ fn time_tdex(plan: &BenchPlan) -> Result<EngineBench> {
         liggghts_seconds: None,
         ratio: None,
         liggghts_dir: None,
-    })
+    };
+    Ok((bench, peer_dir))
 }
 
 fn print_table(r: &EngineBench) {

@@ -1,16 +1,23 @@
 //! The LIGGGHTS 3.8 peer of `tdex bench CASE`: the case written as a LIGGGHTS deck (same
 //! materials, Hertz + history + rolling, conduction, the drum as an STL mesh turned by
-//! `fix move/mesh`), run on one process for the same steps after the same settling.
+//! `fix move/mesh`), started from tdex's own bed at t0 and run on one process for the same steps.
 
 use crate::cli::BenchPlan;
 use anyhow::{bail, Context, Result};
 use recorder::case::{Case, ContactArea, EndCaps, RollingModel, TemperatureSpec};
+use recorder::particles::ParticleSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The deck, with `@name@` placeholders (shared with `tests/liggghts/deck_from_case.py`).
 const DECK: &str = include_str!("liggghts_deck.in");
+/// The deck's `@start@` here: the bed read from tdex's state at t0 (the Python script's
+/// `liggghts_start_settle.in` lets LIGGGHTS insert and settle its own bed instead, which
+/// costs the settling and spin-up again, and `insert/pack` cannot place a dense fill).
+const START_FROM_STATE: &str = include_str!("liggghts_start_state.in");
+/// The LIGGGHTS data file of tdex's bed at t0, read by the deck.
+const STATE_FILE: &str = "t0.data";
 /// Facets around the drum's circumference.
 const FACETS_AROUND: usize = 96;
 /// Target length (m) of one mantle facet along the axis.
@@ -22,15 +29,25 @@ pub struct PeerRate {
     pub dir: PathBuf,
 }
 
-/// Writes the deck into `dir` (a new temporary directory if `None`), runs `liggghts` there and
-/// reads the rate of its last run (the heated phase) from the log.
-pub fn run(plan: &BenchPlan, dir: Option<&Path>) -> Result<PeerRate> {
+/// Writes tdex's bed at `t0` and the deck into `dir` (a new temporary directory if `None`), to
+/// be run by [`run`]; returns the directory. Called at `t0`, before tdex's timed steps, so that
+/// the bed is written as it streams out rather than kept.
+pub fn prepare(plan: &BenchPlan, at_t0: &ParticleSet, dir: Option<&Path>) -> Result<PathBuf> {
     let dir = match dir {
         Some(d) => d.to_path_buf(),
         None => std::env::temp_dir().join(format!("tdex-bench-liggghts-{}", std::process::id())),
     };
     tdex_format::output::create_dir_all(&dir)?;
+    tdex_format::output::write_with(&dir.join(STATE_FILE), |out| {
+        write_state(&plan.case, at_t0, out)
+    })?;
     write_deck(&plan.case, &plan.case_path, plan.steps, &dir)?;
+    Ok(dir)
+}
+
+/// Runs `liggghts` in the directory [`prepare`] wrote and reads the rate of its last run (the
+/// heated phase) from the log.
+pub fn run(plan: &BenchPlan, dir: PathBuf) -> Result<PeerRate> {
     let bar = crate::progress::spinner(
         plan.json,
         &format!("LIGGGHTS 3.8, 1 process, in {}", dir.display()),
@@ -91,22 +108,51 @@ fn last_loop_time(log: &str) -> Option<(f64, u64, u64)> {
     ))
 }
 
-/// The first prime above `n` (LIGGGHTS wants prime seeds above 10 000).
-fn next_prime(mut n: u64) -> u64 {
-    let is_prime = |n: u64| {
-        n >= 2
-            && (2..)
-                .take_while(|d| d * d <= n)
-                .all(|d| !n.is_multiple_of(d))
-    };
-    while !is_prime(n) {
-        n += 1;
+/// Writes the LIGGGHTS data file (`read_data`, `atom_style granular`) of the bed: the box of
+/// the deck, then every particle's type, diameter, density and position, and its velocity and
+/// angular velocity, at full precision (`{:?}` prints the shortest decimal that reads back to
+/// the same `f64`).
+fn write_state(
+    case: &Case,
+    bed: &ParticleSet,
+    out: &mut impl std::io::Write,
+) -> std::io::Result<()> {
+    let (bx, by) = box_half_widths(case);
+    write!(
+        out,
+        "LIGGGHTS data file: the bed of tdex case '{}' at t0\n\n{} atoms\n2 atom types\n\n\
+         {:?} {bx:?} xlo xhi\n{:?} {by:?} ylo yhi\n{:?} {bx:?} zlo zhi\n\nAtoms\n\n",
+        case.name,
+        bed.len(),
+        -bx,
+        -by,
+        -bx,
+    )?;
+    let density = case.material.density;
+    for k in 0..bed.len() {
+        let [x, y, z] = bed.pos[k];
+        let diameter = 2.0 * bed.radius[k];
+        writeln!(
+            out,
+            "{} 1 {diameter:?} {density:?} {x:?} {y:?} {z:?}",
+            k + 1
+        )?;
     }
-    n
+    write!(out, "\nVelocities\n\n")?;
+    for k in 0..bed.len() {
+        let ([vx, vy, vz], [wx, wy, wz]) = (bed.vel[k], bed.omega[k]);
+        writeln!(out, "{} {vx:?} {vy:?} {vz:?} {wx:?} {wy:?} {wz:?}", k + 1)?;
+    }
+    Ok(())
+}
+
+/// Half-widths of the deck's box across (x, z) and along (y) the drum: a centimetre beyond it.
+fn box_half_widths(case: &Case) -> (f64, f64) {
+    (case.drum.radius + 0.01, case.drum.length / 2.0 + 0.01)
 }
 
 /// Writes `in.drum` and the drum mesh for `case`, heating for `heating_steps` after `t0`.
-pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> Result<()> {
+fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> Result<()> {
     let TemperatureSpec::Split {
         hot,
         cold,
@@ -152,17 +198,13 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         b[2 * axis + 1] = upper;
         b.join(" ")
     };
-    let s1 = next_prime(10_001 + case.seed % 1_000_000_000);
-    let s2 = next_prime(s1 + 1);
-    let s3 = next_prime(s2 + 1);
     let (m, pp, pw) = (
         &case.material,
         &case.contact.particle_particle,
         &case.contact.particle_wall,
     );
     let e_real = case.conduction.youngs_modulus_real;
-    let settle = case.steps_in(case.time.settle);
-    let values: Vec<(&str, String)> = vec![
+    let mut values: Vec<(&str, String)> = vec![
         (
             "case",
             case_path
@@ -171,15 +213,12 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         ),
         ("name", case.name.clone()),
         ("seed", case.seed.to_string()),
-        ("bx", (r + 0.01).to_string()),
-        ("by", (l / 2.0 + 0.01).to_string()),
+        ("box", format!("read_data       {STATE_FILE}")),
         ("skin", (0.4 * rp).to_string()),
         ("E", m.youngs_modulus.to_string()),
         ("nu", m.poisson_ratio.to_string()),
         ("k", m.conductivity.to_string()),
         ("cp", m.heat_capacity.to_string()),
-        ("rho", m.density.to_string()),
-        ("rp", rp.to_string()),
         ("N", case.particles.count.to_string()),
         ("dt", case.time.dt.to_string()),
         ("e_pp", pp.restitution.to_string()),
@@ -214,15 +253,7 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         ("T_init", (0.5 * (hot + cold)).to_string()),
         ("T_hot", hot.to_string()),
         ("T_cold", cold.to_string()),
-        ("rins", (r - 1.5 * rp).to_string()),
-        ("yins", (l / 2.0 - 1.5 * rp).to_string()),
-        ("seed1", s1.to_string()),
-        ("seed2", s2.to_string()),
-        ("seed3", s3.to_string()),
-        ("nsettle", settle.to_string()),
-        ("nsettle_rest", settle.saturating_sub(1).to_string()),
         ("period", case.drum.rotation_period.to_string()),
-        ("nspin", case.steps_in(case.time.spin_up).to_string()),
         ("nheat", heating_steps.to_string()),
         // the import test's dumps (tests/liggghts/deck_from_case.py --dumps) are not timed here
         ("pair_compute", String::new()),
@@ -232,26 +263,34 @@ pub fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path)
         ("tmp_block", block("${mid}")),
         ("hot_block", block("${split}")),
     ];
-    let mut deck = String::with_capacity(DECK.len() + 512);
-    let mut rest = DECK;
+    let start = fill(START_FROM_STATE, &values)?;
+    values.push(("start", start));
+    let deck = fill(DECK, &values)?;
+    let path = dir.join("in.drum");
+    tdex_format::output::write_atomically(&path, deck.as_bytes())?;
+    Ok(())
+}
+
+/// `template` with every `@key@` replaced by its value.
+fn fill(template: &str, values: &[(&str, String)]) -> Result<String> {
+    let mut out = String::with_capacity(template.len() + 512);
+    let mut rest = template;
     while let Some(at) = rest.find('@') {
-        deck.push_str(&rest[..at]);
+        out.push_str(&rest[..at]);
         let after = &rest[at + 1..];
         let end = after
             .find('@')
-            .context("liggghts_deck.in: an unclosed @placeholder@")?;
+            .context("the LIGGGHTS deck template: an unclosed @placeholder@")?;
         let key = &after[..end];
         let value = values
             .iter()
             .find(|(k, _)| *k == key)
-            .with_context(|| format!("liggghts_deck.in: no value for @{key}@"))?;
-        deck.push_str(&value.1);
+            .with_context(|| format!("the LIGGGHTS deck template: no value for @{key}@"))?;
+        out.push_str(&value.1);
         rest = &after[end + 1..];
     }
-    deck.push_str(rest);
-    let path = dir.join("in.drum");
-    tdex_format::output::write_atomically(&path, deck.as_bytes())?;
-    Ok(())
+    out.push_str(rest);
+    Ok(out)
 }
 
 /// An ASCII STL of the drum (axis y through the origin): the mantle and/or the end caps.
@@ -318,11 +357,5 @@ mod tests {
                    ...\nLoop time of 12.25 on 1 procs for 5000 steps with 20000 atoms\n";
         assert_eq!(last_loop_time(log), Some((12.25, 5000, 20000)));
         assert_eq!(last_loop_time("no runs"), None);
-    }
-
-    #[test]
-    fn seeds_are_primes_above_ten_thousand() {
-        assert_eq!(next_prime(10_001 + 42), 10_061);
-        assert_eq!(next_prime(10_062), 10_067);
     }
 }

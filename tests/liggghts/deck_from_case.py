@@ -75,7 +75,10 @@ def steps(seconds, dt, what):
     return n
 
 
-DECK = (Path(__file__).resolve().parents[2] / "src" / "bench" / "liggghts_deck.in").read_text()
+BENCH = Path(__file__).resolve().parents[2] / "src" / "bench"
+DECK = (BENCH / "liggghts_deck.in").read_text()
+# the deck's @start@: LIGGGHTS inserts, settles and spins up the bed itself
+START = (BENCH / "liggghts_start_settle.in").read_text()
 
 
 IMPORT_DUMPS = """\
@@ -174,6 +177,8 @@ def main():
     v["pair_compute"] = "compute pc all pair/gran/local id contactArea" if len(sys.argv) > 3 else ""
     v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"], rotating)
                       if len(sys.argv) > 3 else f"run {v['nheat']}")
+    v["box"] = f"region          domain block -{v['bx']} {v['bx']} -{v['by']} {v['by']} -{v['bx']} {v['bx']} units box\ncreate_box      2 domain"
+    v["start"] = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), START)
     deck = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), DECK)
     (out / "in.drum").write_text(deck)
     print(f"wrote {out}/in.drum: N={v['N']} R={R} L={L} settle={v['nsettle']} spin={v['nspin']} "
