@@ -163,6 +163,19 @@ impl Axial {
         }
     }
 
+    /// The t0 and t1 indices sorted along the axis.
+    pub(crate) fn sorted(&self) -> (&[u32], &[u32]) {
+        (&self.s0, &self.s1)
+    }
+
+    /// Extent of the t0 points along the axis.
+    pub(crate) fn length(&self, x0: &[[f64; 3]]) -> f64 {
+        match (self.s0.first(), self.s0.last()) {
+            (Some(&a), Some(&b)) => x0[b as usize][self.axis] - x0[a as usize][self.axis],
+            _ => 0.0,
+        }
+    }
+
     /// Mean |δ|, in the units of the coordinates.
     pub(crate) fn mean_abs_shift(&self) -> f64 {
         self.delta.iter().map(|d| d.abs()).sum::<f64>() / self.delta.len().max(1) as f64
