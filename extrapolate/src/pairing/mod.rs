@@ -365,8 +365,8 @@ fn sparse(
     let x0: Vec<[f64; 3]> = perm0.iter().map(|&i| x0_in[i as usize]).collect();
     let x1: Vec<[f64; 3]> = perm1.iter().map(|&i| x1_in[i as usize]).collect();
     let (x0, x1) = (&x0[..], &x1[..]);
-    let tree = candidates::build_tree(x0);
-    trace!(t, "morton order + kiddo tree, n {n}");
+    let grid = candidates::Grid::new(x0);
+    trace!(t, "morton order + grid, n {n}");
 
     // Candidates and warm-start potentials follow the transport along the bed's long
     // axis (`candidates::Axial`; docs/pairing.md, "Long drums").
@@ -383,14 +383,14 @@ fn sparse(
     let k_axial = (opts.k_initial * AXIAL_K_NUM / AXIAL_K_DEN).clamp(1, n);
     let k_plain = opts.k_initial.min(n);
     let rho_sampled =
-        candidates::mean_cheapest_sampled(&tree, x0, x1, &centres, k_plain, AXIAL_SAMPLE, scale)
+        candidates::mean_cheapest_sampled(&grid, x0, x1, &centres, k_plain, AXIAL_SAMPLE, scale)
             * scale.unit();
     let mut k0 = if shift > rho_sampled {
         k_axial
     } else {
         k_plain
     };
-    let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
+    let (mut kc, mut kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
     let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
     let rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
@@ -485,7 +485,7 @@ fn sparse(
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
-            (kc, kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
+            (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
             graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
