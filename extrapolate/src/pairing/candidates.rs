@@ -13,16 +13,17 @@ use super::cost::{dist2, CostScale};
 /// indices.
 pub(crate) type Tree = ImmutableKdTree<f64, 3>;
 
-/// Mean number of t0 points per grid cell: a k-nearest query with k = 24 or 32 then
-/// reads a few dozen cells.
-const POINTS_PER_CELL: f64 = 2.0;
+/// Mean number of t0 points per occupied grid cell: a k-nearest query with k = 24 or
+/// 32 then reads the 125 cells within two of its own. On the long kiln and the pilot
+/// drum, 1 was as fast as 1.4 and faster than 0.6 or 2 (docs/benchmarks.md).
+const POINTS_PER_CELL: f64 = 1.0;
 
 /// The t0 points bucketed in a uniform grid of cubic cells over their bounding box, for
 /// the k-nearest queries of [`knn`]. On a packed bed the points fill the box's cells
 /// evenly enough (a drum's bed fills part of its box: the empty cells cost a visit,
 /// nothing more) that a query reads the few cells around it, where the k-d tree
 /// walked down and back up a deep tree for every query (0.65 s for the long kiln's
-/// 80 000 32-nearest queries on the shared 2-core machine, against 0.1-0.2 s here).
+/// 80 000 32-nearest queries on the shared 2-core machine, against about 0.3 s here).
 pub(crate) struct Grid {
     lo: [f64; 3],
     cell: f64,
