@@ -1,6 +1,6 @@
 //! Warm start of a long bed by axial slabs: the auction run on square sub-problems cut
 //! across the bed's long axis, in parallel, their prices then joined into one global
-//! ε-complementary-slackness state (docs/pairing.md, "Long drums: slabs").
+//! ε-complementary-slackness state (docs/pairing.md, "Long drums: axial slabs").
 //!
 //! On a long drum with an axial transport the global auction's price war runs along the
 //! whole bed: every row takes part in carrying the transport from one end to the other,
@@ -35,7 +35,7 @@ const MIN_SLAB_ROWS: usize = 2_000;
 /// 22, 17 and 15 bids per row, and the seams 8, 9, 14 and 40 (docs/benchmarks.md).
 const MIN_SLAB_LENGTH_RHO: f64 = 40.0;
 
-/// Each slab is solved with this fraction of its ranks more on either side: the
+/// Each slab is solved with 1/`OVERLAP_DEN` of its ranks more on either side: the
 /// overlap where its potentials are compared with its neighbours'.
 const OVERLAP_DEN: usize = 10;
 
