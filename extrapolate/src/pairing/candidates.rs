@@ -1,32 +1,211 @@
 //! The sparse candidate graph: for every t1 point (row), its k nearest t0 points
-//! (columns, found with a kiddo k-d tree), plus the exit edges and certificate pairs
-//! added since. Stored as compressed rows with the integer cost of each edge. The graph
-//! only ever grows, so a warm-started solver never loses the edges it stands on.
+//! (columns, found on a uniform grid of cells over the t0 points), plus the exit edges
+//! and certificate pairs added since. Stored as compressed rows with the integer cost
+//! of each edge. The graph only ever grows, so a warm-started solver never loses the
+//! edges it stands on.
 
-use std::num::NonZeroUsize;
-
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use kiddo::ImmutableKdTree;
 use rayon::prelude::*;
 
-use super::cost::CostScale;
+use super::cost::{dist2, CostScale};
 
-/// k-d tree over the t0 positions; items are t0 indices.
+/// k-d tree over t0 positions (the exit edges' nearest-one queries); items are t0
+/// indices.
 pub(crate) type Tree = ImmutableKdTree<f64, 3>;
 
-/// Builds the tree over the t0 points. Serial construction (kiddo's threading is off),
-/// so the tree, and with it the order of equal-distance results, never depends on the
-/// number of threads.
-pub(crate) fn build_tree(x0: &[[f64; 3]]) -> Tree {
-    // Item indices are u32; the caller has checked that n fits.
-    Tree::new_from_slice(x0).expect("n fits in u32, checked by the caller")
+/// Mean number of t0 points per occupied grid cell: a k-nearest query with k = 24 or
+/// 32 then reads the 125 cells within two of its own. On the long kiln and the pilot
+/// drum, 1 was as fast as 1.4 and faster than 0.6 or 2 (docs/benchmarks.md).
+const POINTS_PER_CELL: f64 = 1.0;
+
+/// The t0 points bucketed in a uniform grid of cubic cells over their bounding box, for
+/// the k-nearest queries of [`knn`]. On a packed bed the points fill the box's cells
+/// evenly enough (a drum's bed fills part of its box: the empty cells cost a visit,
+/// nothing more) that a query reads the few cells around it, where the k-d tree
+/// walked down and back up a deep tree for every query (0.65 s for the long kiln's
+/// 80 000 32-nearest queries on the shared 2-core machine, against about 0.3 s here).
+pub(crate) struct Grid {
+    lo: [f64; 3],
+    cell: f64,
+    dims: [usize; 3],
+    /// Points of cell c: `pts[start[c]..start[c + 1]]` (and their t0 indices in `idx`),
+    /// cells in x-fastest order, points within a cell by index.
+    start: Vec<u32>,
+    pts: Vec<[f64; 3]>,
+    idx: Vec<u32>,
 }
 
-/// The k nearest t0 points of every t1 point, as a flat row-major array (`k` entries per
-/// row) of column indices and the matching integer costs. Within a row, entries are
-/// ordered by (cost, column) so that the result is the same whatever the traversal order
-/// inside the tree or the number of threads.
+impl Grid {
+    pub(crate) fn new(x0: &[[f64; 3]]) -> Self {
+        let (lo, hi) = super::order::bounds(x0, &[]);
+        let extent: [f64; 3] = std::array::from_fn(|a| (hi[a] - lo[a]).max(0.0));
+        // At most ~8 cells per point in all, whatever the box's shape.
+        let max_cells = 8 * x0.len().max(1);
+        let dims_for = |cell: f64| -> [usize; 3] {
+            std::array::from_fn(|a| ((extent[a] / cell).floor() as usize + 1).max(1))
+        };
+        let fit = |mut cell: f64| -> (f64, [usize; 3]) {
+            if !(cell.is_finite() && cell > 0.0) {
+                cell = extent.iter().copied().fold(0.0, f64::max).max(1.0);
+            }
+            let mut dims = dims_for(cell);
+            while dims.iter().product::<usize>() > max_cells {
+                cell *= 1.5;
+                dims = dims_for(cell);
+            }
+            (cell, dims)
+        };
+        // Cells of volume POINTS_PER_CELL / density. The density is first that of the
+        // box (degenerate axes, as in a flat or linear test bed, count with a sliver
+        // of the largest extent), then that of the cells the points occupy: a drum's
+        // bed fills a third of its box, where the box's density would put three times
+        // too many points in every occupied cell.
+        let big = extent.iter().copied().fold(0.0, f64::max);
+        let volume: f64 = extent.iter().map(|&e| e.max(big * 1e-9)).product();
+        let n = x0.len().max(1) as f64;
+        let (coarse, coarse_dims) = fit((volume * POINTS_PER_CELL / n).cbrt());
+        let mut occupied = vec![false; coarse_dims.iter().product::<usize>()];
+        for p in x0 {
+            let c: [usize; 3] = std::array::from_fn(|a| {
+                (((p[a] - lo[a]) / coarse).floor().max(0.0) as usize).min(coarse_dims[a] - 1)
+            });
+            occupied[c[0] + coarse_dims[0] * (c[1] + coarse_dims[1] * c[2])] = true;
+        }
+        let filled = occupied.iter().filter(|&&o| o).count() as f64;
+        let (cell, dims) = fit((filled * coarse.powi(3) * POINTS_PER_CELL / n).cbrt());
+        let cells = dims.iter().product::<usize>();
+        let mut grid = Self {
+            lo,
+            cell,
+            dims,
+            start: vec![0; cells + 1],
+            pts: Vec::with_capacity(x0.len()),
+            idx: Vec::with_capacity(x0.len()),
+        };
+        let of: Vec<u32> = x0.iter().map(|p| grid.cell_of(p) as u32).collect();
+        for &c in &of {
+            grid.start[c as usize + 1] += 1;
+        }
+        for c in 0..cells {
+            grid.start[c + 1] += grid.start[c];
+        }
+        let mut fill = grid.start.clone();
+        grid.pts.resize(x0.len(), [0.0; 3]);
+        grid.idx.resize(x0.len(), 0);
+        for (i, &c) in of.iter().enumerate() {
+            let slot = fill[c as usize] as usize;
+            fill[c as usize] += 1;
+            grid.pts[slot] = x0[i];
+            grid.idx[slot] = i as u32;
+        }
+        grid
+    }
+
+    /// Cell coordinates of a position, clamped to the grid.
+    #[inline]
+    fn coords(&self, p: &[f64; 3]) -> [usize; 3] {
+        std::array::from_fn(|a| {
+            let c = ((p[a] - self.lo[a]) / self.cell).floor();
+            if c <= 0.0 {
+                0
+            } else {
+                (c as usize).min(self.dims[a] - 1)
+            }
+        })
+    }
+
+    #[inline]
+    fn cell_of(&self, p: &[f64; 3]) -> usize {
+        let c = self.coords(p);
+        c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
+    }
+
+    /// The k nearest points to `q` by squared distance, ties to the lower index,
+    /// as (squared distance, t0 index), in `best` (cleared first; k <= number of
+    /// points). Reads the cubes of cells of growing half-width around q's cell until
+    /// the k-th distance is within the cube (every cell outside it lies further away).
+    fn nearest(&self, q: &[f64; 3], k: usize, best: &mut Vec<(f64, u32)>) {
+        best.clear();
+        let c = self.coords(q);
+        let max_r = self.dims.iter().copied().max().unwrap_or(1);
+        for r in 0..=max_r {
+            // The shell of half-width r: cells with Chebyshev distance r from c.
+            let lo: [isize; 3] = std::array::from_fn(|a| c[a] as isize - r as isize);
+            let hi: [isize; 3] = std::array::from_fn(|a| c[a] as isize + r as isize);
+            for z in lo[2].max(0)..=hi[2].min(self.dims[2] as isize - 1) {
+                for y in lo[1].max(0)..=hi[1].min(self.dims[1] as isize - 1) {
+                    let on_yz = z == lo[2] || z == hi[2] || y == lo[1] || y == hi[1];
+                    let row = self.dims[0] * (y as usize + self.dims[1] * z as usize);
+                    let mut visit = |x: isize| {
+                        let cell = row + x as usize;
+                        let (a, b) = (self.start[cell] as usize, self.start[cell + 1] as usize);
+                        for t in a..b {
+                            let d2 = dist2(q, &self.pts[t]);
+                            push_best(best, k, (d2, self.idx[t]));
+                        }
+                    };
+                    if on_yz {
+                        for x in lo[0].max(0)..=hi[0].min(self.dims[0] as isize - 1) {
+                            visit(x);
+                        }
+                    } else {
+                        for x in [lo[0], hi[0]] {
+                            if x >= 0 && x < self.dims[0] as isize {
+                                visit(x);
+                            }
+                        }
+                    }
+                }
+            }
+            if best.len() == k {
+                // Distance from q to the outside of the cube of half-width r (an
+                // axis whose cube reaches the grid's edge on a side has nothing
+                // beyond it on that side).
+                let mut reach = f64::INFINITY;
+                for a in 0..3 {
+                    if lo[a] > 0 {
+                        reach = reach.min(q[a] - (self.lo[a] + lo[a] as f64 * self.cell));
+                    }
+                    if hi[a] < self.dims[a] as isize - 1 {
+                        reach = reach.min(self.lo[a] + (hi[a] + 1) as f64 * self.cell - q[a]);
+                    }
+                }
+                // A margin far above the rounding of the cell boundaries, far below
+                // any spacing of real points.
+                let reach = reach - 1e-9 * self.cell;
+                if reach == f64::INFINITY || (reach > 0.0 && best[k - 1].0 < reach * reach) {
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// Inserts `e` into `best`, kept sorted by (squared distance, index) and at most `k`
+/// long.
+#[inline]
+fn push_best(best: &mut Vec<(f64, u32)>, k: usize, e: (f64, u32)) {
+    let less = |a: &(f64, u32), b: &(f64, u32)| a.0 < b.0 || (a.0 == b.0 && a.1 < b.1);
+    if best.len() == k {
+        if !less(&e, &best[k - 1]) {
+            return;
+        }
+        best.pop();
+    }
+    let mut i = best.len();
+    while i > 0 && less(&e, &best[i - 1]) {
+        i -= 1;
+    }
+    best.insert(i, e);
+}
+
+/// The k nearest t0 points of every t1 point's query centre, as a flat row-major array
+/// (`k` entries per row) of column indices and the matching integer costs. Within a
+/// row, entries are ordered by (cost, column); the nearest are chosen by squared
+/// distance, ties to the lower index, so the result never depends on the number of
+/// threads.
 pub(crate) fn knn(
-    tree: &Tree,
+    grid: &Grid,
     x0: &[[f64; 3]],
     x1: &[[f64; 3]],
     centres: &[[f64; 3]],
@@ -35,7 +214,6 @@ pub(crate) fn knn(
 ) -> (Vec<u32>, Vec<i64>) {
     let n = x1.len();
     let k = k.clamp(1, x0.len());
-    let kk = NonZeroUsize::new(k).expect("k >= 1");
     let mut cols = vec![0u32; n * k];
     let mut costs = vec![0i64; n * k];
     // Each row writes only its own k-slot chunk: embarrassingly parallel and
@@ -44,22 +222,24 @@ pub(crate) fn knn(
         .zip(costs.par_chunks_mut(k))
         .enumerate()
         .with_min_len(256)
-        .for_each(|(p, (cc, cs))| {
-            let found = tree
-                .query(&centres[p])
-                .nearest_n::<SquaredEuclidean<f64>>(kk)
-                .execute();
-            let mut row: Vec<(i64, u32)> = found
-                .iter()
-                .map(|r| (scale.cost(&x1[p], &x0[r.item as usize]), r.item))
-                .collect();
-            row.sort_unstable();
-            debug_assert_eq!(row.len(), k);
-            for (s, (c, q)) in row.into_iter().enumerate() {
-                cc[s] = q;
-                cs[s] = c;
-            }
-        });
+        .for_each_init(
+            || (Vec::with_capacity(k + 1), Vec::with_capacity(k)),
+            |(found, row), (p, (cc, cs))| {
+                grid.nearest(&centres[p], k, found);
+                row.clear();
+                row.extend(
+                    found
+                        .iter()
+                        .map(|&(_, q)| (scale.cost(&x1[p], &x0[q as usize]), q)),
+                );
+                row.sort_unstable();
+                debug_assert_eq!(row.len(), k);
+                for (s, &(c, q)) in row.iter().enumerate() {
+                    cc[s] = q;
+                    cs[s] = c;
+                }
+            },
+        );
     (cols, costs)
 }
 
@@ -68,7 +248,7 @@ pub(crate) fn knn(
 /// fixed sample of its rows without building the graph. With `stride = 1` it is exactly
 /// that mean.
 pub(crate) fn mean_cheapest_sampled(
-    tree: &Tree,
+    grid: &Grid,
     x0: &[[f64; 3]],
     x1: &[[f64; 3]],
     centres: &[[f64; 3]],
@@ -83,7 +263,7 @@ pub(crate) fn mean_cheapest_sampled(
         .map(|(p, c)| (*p, *c))
         .unzip();
     let k = k.clamp(1, x0.len());
-    let (_, costs) = knn(tree, x0, &rows, &row_centres, k, scale);
+    let (_, costs) = knn(grid, x0, &rows, &row_centres, k, scale);
     // Each row's entries are sorted by cost: the first is its cheapest.
     let sum: i128 = costs.chunks(k).map(|row| row[0] as i128).sum();
     sum as f64 / rows.len().max(1) as f64
@@ -160,6 +340,19 @@ impl Axial {
             s0,
             s1,
             delta,
+        }
+    }
+
+    /// The t0 and t1 indices sorted along the axis.
+    pub(crate) fn sorted(&self) -> (&[u32], &[u32]) {
+        (&self.s0, &self.s1)
+    }
+
+    /// Extent of the t0 points along the axis.
+    pub(crate) fn length(&self, x0: &[[f64; 3]]) -> f64 {
+        match (self.s0.first(), self.s0.last()) {
+            (Some(&a), Some(&b)) => x0[b as usize][self.axis] - x0[a as usize][self.axis],
+            _ => 0.0,
         }
     }
 
@@ -278,8 +471,8 @@ mod tests {
         let x0: Vec<[f64; 3]> = (0..50).map(|i| [i as f64, 0.0, 0.0]).collect();
         let x1 = vec![[10.2, 0.0, 0.0], [-3.0, 0.0, 0.0]];
         let scale = CostScale::new(&x0, &x1, 1e-3).unwrap();
-        let tree = build_tree(&x0);
-        let (c, w) = knn(&tree, &x0, &x1, &x1, 3, &scale);
+        let grid = Grid::new(&x0);
+        let (c, w) = knn(&grid, &x0, &x1, &x1, 3, &scale);
         assert_eq!(&c[..3], &[10, 11, 9]);
         assert_eq!(&w[..3], &[200, 800, 1200]);
         assert_eq!(&c[3..], &[0, 1, 2]);
@@ -289,6 +482,50 @@ mod tests {
         assert_eq!(g.row(1).1[4], 43000);
         assert_eq!(g.edges(), 8);
         assert_eq!(g.rows(), 2);
+    }
+
+    /// The grid's k nearest are the brute force's (by squared distance, ties to the
+    /// lower index) for queries inside and outside the points' box, on a bulk bed, a
+    /// flat one, a line and a lattice with exact ties.
+    #[test]
+    fn grid_nearest_matches_brute_force() {
+        let mut s = 77u64;
+        let mut rnd = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let bulk: Vec<[f64; 3]> = (0..900).map(|_| [rnd(), 3.0 * rnd(), rnd()]).collect();
+        let flat: Vec<[f64; 3]> = (0..300).map(|_| [rnd(), rnd(), 0.5]).collect();
+        let line: Vec<[f64; 3]> = (0..200).map(|_| [0.0, 10.0 * rnd(), 0.0]).collect();
+        let lattice: Vec<[f64; 3]> = (0..343)
+            .map(|i| [(i % 7) as f64, ((i / 7) % 7) as f64, (i / 49) as f64])
+            .collect();
+        let one = vec![[1.0, 2.0, 3.0]; 5];
+        for x0 in [bulk, flat, line, lattice, one] {
+            let grid = Grid::new(&x0);
+            let mut best = Vec::new();
+            for t in 0..60 {
+                let q = if t % 3 == 0 {
+                    x0[t % x0.len()]
+                } else {
+                    [8.0 * rnd() - 2.0, 14.0 * rnd() - 2.0, 8.0 * rnd() - 2.0]
+                };
+                for k in [1, 3, 24, x0.len()] {
+                    let k = k.min(x0.len());
+                    grid.nearest(&q, k, &mut best);
+                    let mut all: Vec<(f64, u32)> = x0
+                        .iter()
+                        .enumerate()
+                        .map(|(i, p)| (dist2(&q, p), i as u32))
+                        .collect();
+                    all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                    all.truncate(k);
+                    assert_eq!(best, all, "k {k}, query {q:?}");
+                }
+            }
+        }
     }
 
     /// With every row sampled, the estimate is the graph's own mean cheapest cost; a
@@ -309,15 +546,15 @@ mod tests {
         };
         let (x0, x1) = (lattice(0.0), lattice(0.6));
         let scale = CostScale::new(&x0, &x1, 1e-3).unwrap();
-        let tree = build_tree(&x0);
+        let grid = Grid::new(&x0);
         for centres in [x1.clone(), lattice(-1.4)] {
             for k in [1, 4, 24] {
-                let (c, w) = knn(&tree, &x0, &x1, &centres, k, &scale);
+                let (c, w) = knn(&grid, &x0, &x1, &centres, k, &scale);
                 let g = Graph::build(k, &c, &w, &[], &x0, &x1, &scale);
                 let whole = crate::pairing::sparse_lap::mean_cheapest(&g);
-                let every = mean_cheapest_sampled(&tree, &x0, &x1, &centres, k, 1, &scale);
+                let every = mean_cheapest_sampled(&grid, &x0, &x1, &centres, k, 1, &scale);
                 assert_eq!(every, whole, "k {k}");
-                let sampled = mean_cheapest_sampled(&tree, &x0, &x1, &centres, k, 7, &scale);
+                let sampled = mean_cheapest_sampled(&grid, &x0, &x1, &centres, k, 7, &scale);
                 assert!(
                     (sampled - whole).abs() < 0.2 * whole,
                     "k {k}: {sampled} vs {whole}"

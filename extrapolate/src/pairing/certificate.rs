@@ -25,7 +25,7 @@
 
 use rayon::prelude::*;
 
-use super::cost::CostScale;
+use super::cost::{dist2, CostScale};
 use super::sparse_lap::Lap;
 
 /// At most this many violating pairs per row are returned (the most negative reduced
@@ -199,13 +199,6 @@ fn mindist2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
         s += d * d;
     }
     s
-}
-
-/// Squared distance between two points.
-#[inline]
-fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
-    dx * dx + dy * dy + dz * dz
 }
 
 /// Outcome of one certificate pass.

@@ -14,6 +14,13 @@ const MAX_PAIR_UNITS: f64 = (1u64 << 40) as f64;
 /// are bounded by it, and it must stay far from `i64::MAX` (2^63).
 const MAX_TOTAL_UNITS: f64 = (1u64 << 60) as f64;
 
+/// Squared Euclidean distance between two points.
+#[inline]
+pub(crate) fn dist2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+    let (dx, dy, dz) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    dx * dx + dy * dy + dz * dz
+}
+
 /// Euclidean distance between two points (metres, or whatever the caller uses).
 #[inline]
 pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {

@@ -28,6 +28,7 @@ pub mod cycles;
 mod dense;
 mod feasibility;
 mod order;
+mod slabs;
 mod sparse_lap;
 
 use std::time::Instant;
@@ -260,7 +261,7 @@ pub fn pair(
         return pair_dense(x0, x1, opts.unit);
     }
     let scale = cost::CostScale::new(x0, x1, opts.unit)?;
-    let mut s = sparse(x0, x1, opts, &scale);
+    let (mut s, _) = sparse(x0, x1, opts, &scale, true);
     s.seconds = start.elapsed().as_secs_f64();
     Ok(s)
 }
@@ -344,14 +345,17 @@ fn describe(
     )
 }
 
-/// The sparse solver: renumber, build the kNN graph, warm-start with an auction, solve
-/// (adding exit edges if the graph has no perfect matching), certify, repair, repeat.
+/// The sparse solver: renumber, build the kNN graph, warm-start with an auction (on
+/// axial slabs if `allow_slabs` and the bed calls for them), solve (adding exit edges if
+/// the graph has no perfect matching), certify, repair, repeat. Also returns the number
+/// of slabs used (1: none).
 fn sparse(
     x0_in: &[[f64; 3]],
     x1_in: &[[f64; 3]],
     opts: &PairingOptions,
     scale: &cost::CostScale,
-) -> Pairing {
+    allow_slabs: bool,
+) -> (Pairing, usize) {
     let n = x0_in.len();
     let t = Instant::now();
     // Work on a Morton-ordered copy (cache locality); map back at the end.
@@ -361,8 +365,8 @@ fn sparse(
     let x0: Vec<[f64; 3]> = perm0.iter().map(|&i| x0_in[i as usize]).collect();
     let x1: Vec<[f64; 3]> = perm1.iter().map(|&i| x1_in[i as usize]).collect();
     let (x0, x1) = (&x0[..], &x1[..]);
-    let tree = candidates::build_tree(x0);
-    trace!(t, "morton order + kiddo tree, n {n}");
+    let grid = candidates::Grid::new(x0);
+    trace!(t, "morton order + grid, n {n}");
 
     // Candidates and warm-start potentials follow the transport along the bed's long
     // axis (`candidates::Axial`; docs/pairing.md, "Long drums").
@@ -379,14 +383,14 @@ fn sparse(
     let k_axial = (opts.k_initial * AXIAL_K_NUM / AXIAL_K_DEN).clamp(1, n);
     let k_plain = opts.k_initial.min(n);
     let rho_sampled =
-        candidates::mean_cheapest_sampled(&tree, x0, x1, &centres, k_plain, AXIAL_SAMPLE, scale)
+        candidates::mean_cheapest_sampled(&grid, x0, x1, &centres, k_plain, AXIAL_SAMPLE, scale)
             * scale.unit();
     let mut k0 = if shift > rho_sampled {
         k_axial
     } else {
         k_plain
     };
-    let (mut kc, mut kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
+    let (mut kc, mut kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
     let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
     let rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
@@ -395,25 +399,6 @@ fn sparse(
         "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, sampled {rho_sampled:.3e}) + knn k {k0} + graph"
     );
     let v_axial = axial.potentials(x0, rho, scale.unit());
-    let mut lap = sparse_lap::Lap::new(n);
-    lap.set_potentials(&v_axial);
-    lap.greedy_init(&graph);
-    trace!(
-        t,
-        "axial potentials + row reduction: {} rows free",
-        lap.col_of_row
-            .iter()
-            .filter(|&&q| q == sparse_lap::NONE)
-            .count()
-    );
-    // Warm start: the row reduction, then an ε-scaling auction. The auction moves the
-    // holes left by the row reduction (the long-range part of the transport) far more
-    // cheaply than one Dijkstra search per hole, which scans the whole region between
-    // the hole and a free column. While its potentials are near optimal, the
-    // certificate's search also runs on them, and the pairs it finds join the graph
-    // before the exact phase (`AUCTION_ROUNDS`). Only the auction's potentials and the
-    // matched pairs that satisfy the exact invariant are kept; the exact solver below
-    // does not depend on anything else the auction did.
     let mut eps0 = sparse_lap::initial_eps(&graph);
     let budget = AUCTION_BIDS_PER_ROW * n as u64;
     // With the certificate, the auction pauses at ε0 / AUCTION_REFINE for the
@@ -425,16 +410,70 @@ fn sparse(
             1
         }
     };
-    let mut bids = lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
-    trace!(
-        t,
-        "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
-        eps_pause(eps0),
-        lap.col_of_row
-            .iter()
-            .filter(|&&q| q == sparse_lap::NONE)
-            .count()
-    );
+    // Warm start: the row reduction, then an ε-scaling auction. The auction moves the
+    // holes left by the row reduction (the long-range part of the transport) far more
+    // cheaply than one Dijkstra search per hole, which scans the whole region between
+    // the hole and a free column. While its potentials are near optimal, the
+    // certificate's search also runs on them, and the pairs it finds join the graph
+    // before the exact phase (`AUCTION_ROUNDS`). Only the auction's potentials and the
+    // matched pairs that satisfy the exact invariant are kept; the exact solver below
+    // does not depend on anything else the auction did.
+    //
+    // On a long bed with an axial transport the auction runs first on axial slabs, in
+    // parallel (`slabs`): the global price war grows with the bed's length.
+    let cut = if allow_slabs && shift > rho_sampled {
+        slabs::Slabs::for_bed(n, axial.length(x0), rho)
+    } else {
+        None
+    };
+    let slab_count = cut.as_ref().map_or(1, slabs::Slabs::count);
+    let (mut lap, mut bids) = if let Some(cut) = cut {
+        // The slabs stop where the certified path pauses (the global auction repairs
+        // the seams at that ε, then carries on as below).
+        let eps_slabs = (eps0 / AUCTION_REFINE).max(1);
+        let (mut lap, slab_bids) = slabs::warm_start(
+            &cut,
+            &axial,
+            &graph,
+            x0,
+            x1,
+            scale,
+            &v_axial,
+            [eps0, AUCTION_THETA, eps_slabs],
+            AUCTION_BIDS_PER_ROW,
+        );
+        trace!(
+            t,
+            "{} slabs: auction eps0 {eps0} -> {eps_slabs}: {slab_bids} bids, {} rows free",
+            cut.count(),
+            lap.free_rows()
+        );
+        let seam_bids = lap.auction(&graph, eps_slabs, AUCTION_THETA, eps_pause(eps0), budget);
+        trace!(
+            t,
+            "seams: auction {eps_slabs} -> {}: {seam_bids} bids, {} rows free",
+            eps_pause(eps0),
+            lap.free_rows()
+        );
+        (lap, slab_bids + seam_bids)
+    } else {
+        let mut lap = sparse_lap::Lap::new(n);
+        lap.set_potentials(&v_axial);
+        lap.greedy_init(&graph);
+        trace!(
+            t,
+            "axial potentials + row reduction: {} rows free",
+            lap.free_rows()
+        );
+        let bids = lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+        trace!(
+            t,
+            "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
+            eps_pause(eps0),
+            lap.free_rows()
+        );
+        (lap, bids)
+    };
     // An auction that stops on its budget may be bidding on a graph without a perfect
     // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
     // redone: exit edges (the growth step below) are long, and their potentials make
@@ -446,7 +485,7 @@ fn sparse(
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
-            (kc, kw) = candidates::knn(&tree, x0, x1, &centres, k0, scale);
+            (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
             graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
@@ -564,7 +603,7 @@ fn sparse(
     for (p, &q) in lap.col_of_row.iter().enumerate() {
         g[perm1[p] as usize] = perm0[q as usize];
     }
-    Pairing {
+    let pairing = Pairing {
         total_cost: lap.mcost.iter().sum(),
         total_distance: total_distance(x0_in, x1_in, &g),
         g,
@@ -577,7 +616,8 @@ fn sparse(
         certificate_examined: examined,
         auction_bids: bids,
         seconds: 0.0,
-    }
+    };
+    (pairing, slab_count)
 }
 
 /// Union of two sorted edge lists.

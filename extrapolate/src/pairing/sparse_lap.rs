@@ -89,6 +89,26 @@ impl Lap {
         }
     }
 
+    /// A state made elsewhere (the slabs' warm start): each row's partner (`NONE` if
+    /// free) and matched cost, and the column potentials (all `<= 0`). The matching must
+    /// be one to one; the auction or [`Lap::restore_invariant`] takes it from there.
+    pub(crate) fn from_state(col_of_row: Vec<u32>, mcost: Vec<i64>, v: &[i64]) -> Self {
+        let mut lap = Self::new(col_of_row.len());
+        for (c, &v) in lap.cols.iter_mut().zip(v) {
+            debug_assert!(v <= 0);
+            c.v = v;
+        }
+        for (p, &q) in col_of_row.iter().enumerate() {
+            if q != NONE {
+                debug_assert_eq!(lap.cols[q as usize].row, NONE, "column {q} taken twice");
+                lap.cols[q as usize].row = p as u32;
+            }
+        }
+        lap.col_of_row = col_of_row;
+        lap.mcost = mcost;
+        lap
+    }
+
     /// Sets the column potentials before any matching is made (all must be `<= 0`).
     pub(crate) fn set_potentials(&mut self, v: &[i64]) {
         debug_assert!(self.col_of_row.iter().all(|&q| q == NONE));
@@ -102,6 +122,11 @@ impl Lap {
     #[inline]
     pub(crate) fn v(&self, q: usize) -> i64 {
         self.cols[q].v
+    }
+
+    /// Number of free rows.
+    pub(crate) fn free_rows(&self) -> usize {
+        self.col_of_row.iter().filter(|&&q| q == NONE).count()
     }
 
     /// Row matched to column `q`, or `NONE`.
