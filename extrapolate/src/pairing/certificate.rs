@@ -33,7 +33,7 @@ use super::sparse_lap::Lap;
 /// progress, while a row on an expensive edge cannot flood the graph.
 pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree.
-const LEAF: usize = 16;
+const LEAF: usize = 32;
 /// Relative safety margin on `R_p` and the bounds: floating-point distances and the
 /// conversion of potentials to lengths err by ~1e-16 relative, far below this.
 const REL_MARGIN: f64 = 1e-9;
@@ -50,18 +50,36 @@ struct Node {
     right: u32,
 }
 
+/// Lower bounds of `d(p, q) + W_q` over a node's points, from per-node minima of the
+/// weights `W` (refreshed for every certificate pass, as `v` changes).
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    /// Slope bound along the bed's long axis `a` (the root's widest): `[s, e, m]` with
+    /// `s` the node's least-squares slope of `W` against `x_a`, `e = sqrt(1 − s²)` and
+    /// `m = min(W − s·x_a)`. Since `d(p, q) >= s·(p_a − q_a) + e·L` for `L` the
+    /// distance across the axis (Cauchy–Schwarz, `s² + e² <= 1`), `d + W_q >= s·p_a +
+    /// e·L_min + m`. Where `W` slopes along the axis almost as steeply as the cost
+    /// itself (`|s|` near 1: a long drum whose particles drift along its axis), the
+    /// set `d + W < r` is a long thin ellipsoid along the axis, whose width the axis
+    /// bounds of `lin` (`e = 0`) do not see.
+    slope: [f64; 3],
+    /// Minimum of `W`: `d + W_q >= mindist(p, box) + min W`.
+    min: f64,
+    /// Minima of `W − x_a` (`[0..3]`) and `W + x_a` (`[3..6]`) per axis `a`: since
+    /// `d(p, q) >= ±(p_a − q_a)`, `d + W_q >= p_a + min(W − x_a)` and `>= −p_a +
+    /// min(W + x_a)`.
+    lin: [f64; 6],
+}
+
 /// A static k-d tree over the t0 points (built once per pairing), with per-node minima
 /// of the weights `W` (refreshed for every certificate pass, as `v` changes).
 pub(crate) struct WeightedTree {
     nodes: Vec<Node>,
-    /// Node minima of `W`, parallel to `nodes`.
-    wmin: Vec<f64>,
-    /// Node minima of `W − x_a` (`[0..3]`) and `W + x_a` (`[3..6]`) per axis `a`,
-    /// parallel to `nodes`: since `d(p, q) >= ±(p_a − q_a)`, `d + W_q >= p_a +
-    /// min(W − x_a)` and `>= −p_a + min(W + x_a)`. Where the potentials slope along
-    /// the bed (a long drum whose particles drift along its axis), these bounds prune
-    /// the nodes far along the slope that `mindist + W_min` cannot.
-    wlin: Vec<[f64; 6]>,
+    /// The weight bounds of each node, parallel to `nodes` (one record per node: the
+    /// search reads them together).
+    bounds: Vec<Bounds>,
+    /// The long axis of [`Bounds::slope`].
+    axis: usize,
     /// Points and their t0 indices, in tree order (leaves contiguous).
     pts: Vec<[f64; 3]>,
     idx: Vec<u32>,
@@ -78,10 +96,21 @@ impl WeightedTree {
         build(x0, &mut idx, 0, &mut nodes);
         let pts = idx.iter().map(|&i| x0[i as usize]).collect();
         let n = nodes.len();
+        let root: &Node = &nodes[0];
+        let axis = (0..3)
+            .max_by(|&a, &b| (root.hi[a] - root.lo[a]).total_cmp(&(root.hi[b] - root.lo[b])))
+            .unwrap_or(0);
         Self {
             nodes,
-            wmin: vec![0.0; n],
-            wlin: vec![[0.0; 6]; n],
+            bounds: vec![
+                Bounds {
+                    slope: [0.0, 1.0, 0.0],
+                    min: 0.0,
+                    lin: [0.0; 6],
+                };
+                n
+            ],
+            axis,
             pts,
             idx,
             w: vec![0.0; x0.len()],
@@ -107,15 +136,51 @@ impl WeightedTree {
                         lin[a + 3] = lin[a + 3].min(w + x[a]);
                     }
                 }
-                self.wmin[i] = m;
-                self.wlin[i] = lin;
+                self.bounds[i].min = m;
+                self.bounds[i].lin = lin;
             } else {
-                let (l, r) = (nd.left as usize, nd.right as usize);
-                self.wmin[i] = self.wmin[l].min(self.wmin[r]);
-                let (a, b) = (self.wlin[l], self.wlin[r]);
-                self.wlin[i] = std::array::from_fn(|j| a[j].min(b[j]));
+                let (l, r) = (
+                    &self.bounds[nd.left as usize],
+                    &self.bounds[nd.right as usize],
+                );
+                let m = l.min.min(r.min);
+                let lin = std::array::from_fn(|j| l.lin[j].min(r.lin[j]));
+                self.bounds[i].min = m;
+                self.bounds[i].lin = lin;
             }
         }
+        let (axis, w, pts) = (self.axis, &self.w, &self.pts);
+        self.nodes
+            .par_iter()
+            .zip(self.bounds.par_iter_mut())
+            .with_min_len(64)
+            .for_each(|(nd, bounds)| {
+                let range = nd.start as usize..nd.end as usize;
+                let len = range.len() as f64;
+                let (mut sx, mut sw) = (0.0, 0.0);
+                for t in range.clone() {
+                    sx += pts[t][axis];
+                    sw += w[t];
+                }
+                let (mx, mw) = (sx / len, sw / len);
+                let (mut sxx, mut sxw) = (0.0, 0.0);
+                for t in range.clone() {
+                    let dx = pts[t][axis] - mx;
+                    sxx += dx * dx;
+                    sxw += dx * (w[t] - mw);
+                }
+                let s = if sxx > 0.0 {
+                    (sxw / sxx).clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                };
+                // Rounding could make s² + e² exceed 1 by an ulp; shrink e instead.
+                let e = (1.0 - s * s).max(0.0).sqrt() * (1.0 - 1e-12);
+                let m = range
+                    .map(|t| w[t] - s * pts[t][axis])
+                    .fold(f64::INFINITY, f64::min);
+                bounds.slope = [s, e, m];
+            });
     }
 
     /// Calls `visit(tree position)` for every point with `d + W < r`, skipping every
@@ -128,12 +193,19 @@ impl WeightedTree {
         stack.push(0);
         while let Some(i) = stack.pop() {
             let i = i as usize;
-            let nd = &self.nodes[i];
-            let reach = r - self.wmin[i];
+            let (nd, b) = (&self.nodes[i], &self.bounds[i]);
+            let [s, e, m] = b.slope;
+            let across = r - s * p[self.axis] - m;
+            if across <= 0.0
+                || e * e * mindist2_across(p, &nd.lo, &nd.hi, self.axis) >= across * across
+            {
+                continue;
+            }
+            let reach = r - b.min;
             if reach <= 0.0 || mindist2(p, &nd.lo, &nd.hi) >= reach * reach {
                 continue;
             }
-            let lin = &self.wlin[i];
+            let lin = &b.lin;
             if (0..3).any(|a| p[a] + lin[a] >= r || lin[a + 3] - p[a] >= r) {
                 continue;
             }
@@ -195,6 +267,18 @@ fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>)
 fn mindist2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
     let mut s = 0.0;
     for a in 0..3 {
+        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
+        s += d * d;
+    }
+    s
+}
+
+/// Squared distance from `p` to the box `[lo, hi]` across `axis` (the other two
+/// coordinates only).
+#[inline]
+fn mindist2_across(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3], axis: usize) -> f64 {
+    let mut s = 0.0;
+    for a in (0..3).filter(|&a| a != axis) {
         let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
         s += d * d;
     }

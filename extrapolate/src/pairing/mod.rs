@@ -392,7 +392,8 @@ fn sparse(
     };
     let (mut kc, mut kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     let mut extras: Vec<(u32, u32)> = Vec::new();
-    let mut graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+    let mut graph = candidates::Graph::default();
+    graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
     let rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
     trace!(
         t,
@@ -486,7 +487,7 @@ fn sparse(
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
             (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
-            graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+            graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
             lap.greedy_init(&graph);
@@ -521,7 +522,7 @@ fn sparse(
         }
         let before = graph.edges();
         extras = merge(extras, check.violations);
-        graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+        graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
         added += graph.edges() - before;
         // The auction frees the rows undercut by more than ε by a new edge.
         bids += lap.auction(&graph, eps_pause(eps0), AUCTION_THETA, 1, budget);
@@ -557,7 +558,7 @@ fn sparse(
                 let more = feasibility::exit_edges(&graph, x0, x1, &deficient);
                 grown += more.len();
                 extras = merge(extras, more);
-                graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+                graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
             }
             // A failed search proves there is no perfect matching (the symmetric
             // difference with one would hold an augmenting path), so growth happened.
@@ -593,7 +594,7 @@ fn sparse(
         // grows strictly each round and the loop ends, at worst with all n² pairs.
         added += check.violations.len();
         extras = merge(extras, check.violations);
-        graph = candidates::Graph::build(k0, &kc, &kw, &extras, x0, x1, scale);
+        graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
         let freed = lap.restore_invariant(&graph);
         trace!(t, "round {rounds}: {freed} rows freed");
     };
@@ -620,10 +621,52 @@ fn sparse(
     (pairing, slab_count)
 }
 
-/// Union of two sorted edge lists.
-fn merge(mut a: Vec<(u32, u32)>, b: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
-    a.extend(b);
-    a.sort_unstable();
-    a.dedup();
-    a
+/// Union of two edge lists sorted by (row, column), without repeats. Both are sorted
+/// already (a certificate pass returns its pairs in order, and so does the growth
+/// step), so one linear merge does: sorting the union again cost 6–12 ms per repair
+/// round on the long kiln's 300 000 extra edges.
+fn merge(a: Vec<(u32, u32)>, mut b: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+    if !b.is_sorted() {
+        b.sort_unstable();
+    }
+    debug_assert!(a.is_sorted());
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() || j < b.len() {
+        let e = if j == b.len() || (i < a.len() && a[i] <= b[j]) {
+            i += 1;
+            a[i - 1]
+        } else {
+            j += 1;
+            b[j - 1]
+        };
+        if out.last() != Some(&e) {
+            out.push(e);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The linear merge is the sorted union without repeats, also when the second list
+    /// is unsorted or repeats itself.
+    #[test]
+    fn merge_is_the_sorted_union() {
+        let a = vec![(0, 3), (1, 1), (1, 5), (4, 0)];
+        for b in [
+            vec![(0, 2), (1, 5), (2, 2), (4, 0), (4, 9)],
+            vec![(4, 9), (0, 2), (2, 2), (2, 2), (1, 5)],
+            vec![],
+        ] {
+            let mut want = a.clone();
+            want.extend(b.iter().copied());
+            want.sort_unstable();
+            want.dedup();
+            assert_eq!(merge(a.clone(), b), want);
+        }
+        assert_eq!(merge(Vec::new(), vec![(3, 1), (3, 1)]), vec![(3, 1)]);
+    }
 }
