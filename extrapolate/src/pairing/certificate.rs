@@ -184,8 +184,8 @@ impl WeightedTree {
     }
 
     /// Calls `visit(tree position)` for every point with `d + W < r`, skipping every
-    /// node with `mindist(p, box) + W_min >= r` or with one of the axis bounds of
-    /// `wlin` at least `r`. `stack` is scratch. Both tests are
+    /// node one of whose [`Bounds`] is at least `r` (the slope bound first: on a long
+    /// drum it prunes the most). `stack` is scratch. The tests involving distances are
     /// made on squares (`d < r − W` with `r − W > 0`), without square roots; the
     /// rounding of either form is far below the margin built into `r`.
     fn search(&self, p: &[f64; 3], r: f64, stack: &mut Vec<u32>, mut visit: impl FnMut(usize)) {
@@ -194,15 +194,19 @@ impl WeightedTree {
         while let Some(i) = stack.pop() {
             let i = i as usize;
             let (nd, b) = (&self.nodes[i], &self.bounds[i]);
+            // Squared gaps from p to the box per axis, shared by the two box bounds.
+            let gap2: [f64; 3] = std::array::from_fn(|a| {
+                let d = (nd.lo[a] - p[a]).max(p[a] - nd.hi[a]).max(0.0);
+                d * d
+            });
+            let across: f64 = (0..3).filter(|&a| a != self.axis).map(|a| gap2[a]).sum();
             let [s, e, m] = b.slope;
-            let across = r - s * p[self.axis] - m;
-            if across <= 0.0
-                || e * e * mindist2_across(p, &nd.lo, &nd.hi, self.axis) >= across * across
-            {
+            let rest = r - s * p[self.axis] - m;
+            if rest <= 0.0 || e * e * across >= rest * rest {
                 continue;
             }
             let reach = r - b.min;
-            if reach <= 0.0 || mindist2(p, &nd.lo, &nd.hi) >= reach * reach {
+            if reach <= 0.0 || across + gap2[self.axis] >= reach * reach {
                 continue;
             }
             let lin = &b.lin;
@@ -260,29 +264,6 @@ fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>)
         nodes[me].right = right;
     }
     me as u32
-}
-
-/// Squared distance from `p` to the box `[lo, hi]` (0 inside).
-#[inline]
-fn mindist2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
-    let mut s = 0.0;
-    for a in 0..3 {
-        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
-        s += d * d;
-    }
-    s
-}
-
-/// Squared distance from `p` to the box `[lo, hi]` across `axis` (the other two
-/// coordinates only).
-#[inline]
-fn mindist2_across(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3], axis: usize) -> f64 {
-    let mut s = 0.0;
-    for a in (0..3).filter(|&a| a != axis) {
-        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
-        s += d * d;
-    }
-    s
 }
 
 /// Outcome of one certificate pass.
