@@ -25,6 +25,7 @@
 
 use rayon::prelude::*;
 
+use super::candidates::Graph;
 use super::cost::{dist2, CostScale};
 use super::sparse_lap::Lap;
 
@@ -277,32 +278,52 @@ pub(crate) struct Check {
 /// What the previous passes proved, so that a pass only re-examines the rows where a
 /// violation can have appeared since.
 ///
-/// A pass proves, for every row `p` it examines, `c(p, q) >= u[p] + v[q]` for every
-/// column `q` it does not return (unless it returned more than
-/// [`MAX_ADDED_PER_ROW`]: then the row is examined again next time). The returned
-/// pairs join the candidate graph, where the solver keeps them non-violating. The pair
-/// inequality can only break again if `u[p] + v[q]` grows. Column potentials never
-/// increase in this solver (augmentations and auction bids only lower them; this is
-/// checked, and a full pass is made if it ever fails), so a row needs examining again
-/// only if its own `u[p]` grew since its last examination.
-#[derive(Default)]
+/// A pass that examines row `p` proves a lower bound `b[p]` of `c(p, q) − v[q]` over
+/// every column `q` that is neither a candidate edge of `p` nor returned (unless it
+/// returned more than [`MAX_ADDED_PER_ROW`]: then the row is examined again next
+/// time). Its search reaches `slack` units beyond the violations (`c − v < u[p] +
+/// slack`): every column it does not reach has `c − v >= u[p] + slack`, and the ones
+/// it reaches give their exact `c − v`. Candidate edges and returned pairs stay in the
+/// graph, where the solver keeps them non-violating. Column potentials never increase
+/// in this solver (augmentations and auction bids only lower them; this is checked, and
+/// a full pass is made if it ever fails), so `c − v` only grows and the bound still
+/// holds later: the row needs examining again only once its own `u[p]` exceeds `b[p]`.
+/// With `slack = 0` that is as soon as `u[p]` grew at all since its last examination;
+/// a small slack spares the rows whose `u` a repair solve raises by a little, for a
+/// slightly larger search.
 pub(crate) struct Memo {
-    /// `u[p]` when row `p` was last examined (`i64::MIN`: never).
-    u: Vec<i64>,
+    /// `b[p]` (`i64::MIN`: never examined).
+    bound: Vec<i64>,
     /// `v[q]` at the last pass.
     v: Vec<i64>,
     /// Row returned more than `MAX_ADDED_PER_ROW` violations: examine again.
     again: Vec<bool>,
+    /// How far beyond the violations a search reaches, in cost units (>= 0).
+    slack: i64,
+}
+
+impl Memo {
+    /// Nothing proven yet; searches reach `slack` cost units beyond the violations.
+    pub(crate) fn new(slack: i64) -> Self {
+        Self {
+            bound: Vec::new(),
+            v: Vec::new(),
+            again: Vec::new(),
+            slack: slack.max(0),
+        }
+    }
 }
 
 /// One certificate pass (in parallel over rows, results collected in row order).
-/// `lap` must hold a perfect matching that satisfies the invariant on the current
-/// candidate graph. `memo` carries what earlier passes proved (start with
-/// `Memo::default()`); rows that cannot have gained a violation since are skipped.
+/// `lap` must hold a perfect matching that satisfies the invariant on the candidate
+/// graph `graph`, or ε-CS on it (a pass on the auction's potentials: it may then also
+/// return candidate edges). `memo` carries what earlier passes proved (start with
+/// [`Memo::new`]); rows that cannot have gained a violation since are skipped.
 pub(crate) fn check(
     tree: &mut WeightedTree,
     x1: &[[f64; 3]],
     lap: &Lap,
+    graph: &Graph,
     scale: &CostScale,
     memo: &mut Memo,
 ) -> Check {
@@ -311,7 +332,7 @@ pub(crate) fn check(
     // The skip rule needs every column potential to be at most what it was at the
     // previous pass; otherwise forget everything and examine all rows.
     if memo.v.len() != n || memo.v.iter().zip(&v_now).any(|(old, new)| new > old) {
-        memo.u = vec![i64::MIN; n];
+        memo.bound = vec![i64::MIN; n];
         memo.again = vec![true; n];
     }
     memo.v = v_now;
@@ -319,28 +340,36 @@ pub(crate) fn check(
     let unit = scale.unit();
     tree.set_weights(|q| lap.v(q), v_max, unit);
     let tree = &*tree;
-    let (memo_u, memo_again) = (&memo.u, &memo.again);
-    let per_row: Vec<(Vec<u32>, u64, bool)> = (0..n)
+    let (memo_bound, memo_again, slack) = (&memo.bound, &memo.again, memo.slack);
+    // Per row: the returned columns, the points examined, whether the list was
+    // truncated, and the row's new bound (`None`: not examined, the old one holds).
+    let per_row: Vec<(Vec<u32>, u64, bool, Option<i64>)> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map_init(Vec::new, |stack, p| {
             let u = lap.u(p);
-            if !memo_again[p] && u <= memo_u[p] {
-                return (Vec::new(), 0, false); // proven at an earlier pass, still holds
+            if !memo_again[p] && u <= memo_bound[p] {
+                return (Vec::new(), 0, false, None); // proven at an earlier pass, still holds
             }
             if u + v_max <= 0 {
-                // c >= 0 and v <= v_max: nothing can undercut.
-                return (Vec::new(), 0, false);
+                // c >= 0 and v <= v_max: c − v >= −v_max >= u for every column.
+                return (Vec::new(), 0, false, Some(-v_max));
             }
-            let r = ((u + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
+            // Every column with c − v <= u + slack − 1 has d + W < r (the module
+            // documentation's argument, with u + slack for u).
+            let r = ((u + slack + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
             let mut bad: Vec<(i64, u32)> = Vec::new();
+            let mut near = slack;
             let mut examined = 0u64;
+            let edges = graph.row(p).0;
             tree.search(&x1[p], r, stack, |t| {
                 examined += 1;
-                let q = tree.idx[t] as usize;
-                let reduced = scale.cost(&x1[p], &tree.pts[t]) - u - lap.v(q);
+                let q = tree.idx[t];
+                let reduced = scale.cost(&x1[p], &tree.pts[t]) - u - lap.v(q as usize);
                 if reduced < 0 {
-                    bad.push((reduced, q as u32));
+                    bad.push((reduced, q));
+                } else if reduced < near && !edges.contains(&q) {
+                    near = reduced;
                 }
             });
             let truncated = bad.len() > MAX_ADDED_PER_ROW;
@@ -348,16 +377,16 @@ pub(crate) fn check(
             bad.truncate(MAX_ADDED_PER_ROW);
             let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
             cols.sort_unstable();
-            (cols, examined, truncated)
+            (cols, examined, truncated, Some(u + near))
         })
         .collect();
     let mut violations = Vec::new();
     let mut examined = 0;
-    for (p, (bad, m, truncated)) in per_row.into_iter().enumerate() {
-        if memo.again[p] || lap.u(p) > memo.u[p] {
-            memo.u[p] = lap.u(p); // examined in this pass
+    for (p, (bad, m, truncated, bound)) in per_row.into_iter().enumerate() {
+        if let Some(b) = bound {
+            memo.bound[p] = b;
+            memo.again[p] = truncated;
         }
-        memo.again[p] = truncated;
         examined += m;
         violations.extend(bad.into_iter().map(|q| (p as u32, q)));
     }
