@@ -122,10 +122,17 @@ impl Grid {
 
     /// The k nearest points to `q` by squared distance, ties to the lower index,
     /// as (squared distance, t0 index), in `best` (cleared first; k <= number of
-    /// points). Reads the cubes of cells of growing half-width around q's cell until
-    /// the k-th distance is within the cube (every cell outside it lies further away).
+    /// points), in no particular order. Reads the cubes of cells of growing half-width
+    /// around q's cell until the k-th distance is within the cube (every cell outside
+    /// it lies further away).
+    ///
+    /// The points nearer than the k-th so far are gathered unsorted and cut back to
+    /// the k nearest by a selection whenever 2k are held and at the end of every
+    /// cube: keeping them sorted (an insertion per point) was a quarter of the query.
     fn nearest(&self, q: &[f64; 3], k: usize, best: &mut Vec<(f64, u32)>) {
         best.clear();
+        // The k-th nearest so far, once k are held.
+        let mut kth: Option<(f64, u32)> = None;
         let c = self.coords(q);
         let max_r = self.dims.iter().copied().max().unwrap_or(1);
         for r in 0..=max_r {
@@ -140,8 +147,13 @@ impl Grid {
                         let cell = row + x as usize;
                         let (a, b) = (self.start[cell] as usize, self.start[cell + 1] as usize);
                         for t in a..b {
-                            let d2 = dist2(q, &self.pts[t]);
-                            push_best(best, k, (d2, self.idx[t]));
+                            let e = (dist2(q, &self.pts[t]), self.idx[t]);
+                            if kth.is_none_or(|m| nearer(&e, &m)) {
+                                best.push(e);
+                                if best.len() == 2 * k {
+                                    kth = Some(keep_nearest(best, k));
+                                }
+                            }
                         }
                     };
                     if on_yz {
@@ -157,7 +169,8 @@ impl Grid {
                     }
                 }
             }
-            if best.len() == k {
+            if best.len() >= k {
+                let kth = *kth.insert(keep_nearest(best, k));
                 // Distance from q to the outside of the cube of half-width r (an
                 // axis whose cube reaches the grid's edge on a side has nothing
                 // beyond it on that side).
@@ -173,7 +186,7 @@ impl Grid {
                 // A margin far above the rounding of the cell boundaries, far below
                 // any spacing of real points.
                 let reach = reach - 1e-9 * self.cell;
-                if reach == f64::INFINITY || (reach > 0.0 && best[k - 1].0 < reach * reach) {
+                if reach == f64::INFINITY || (reach > 0.0 && kth.0 < reach * reach) {
                     return;
                 }
             }
@@ -181,22 +194,17 @@ impl Grid {
     }
 }
 
-/// Inserts `e` into `best`, kept sorted by (squared distance, index) and at most `k`
-/// long.
+/// The order of the nearest: squared distance, ties to the lower index.
 #[inline]
-fn push_best(best: &mut Vec<(f64, u32)>, k: usize, e: (f64, u32)) {
-    let less = |a: &(f64, u32), b: &(f64, u32)| a.0 < b.0 || (a.0 == b.0 && a.1 < b.1);
-    if best.len() == k {
-        if !less(&e, &best[k - 1]) {
-            return;
-        }
-        best.pop();
-    }
-    let mut i = best.len();
-    while i > 0 && less(&e, &best[i - 1]) {
-        i -= 1;
-    }
-    best.insert(i, e);
+fn nearer(a: &(f64, u32), b: &(f64, u32)) -> bool {
+    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+}
+
+/// Cuts `best` (at least k entries) back to its k nearest; returns the k-th.
+fn keep_nearest(best: &mut Vec<(f64, u32)>, k: usize) -> (f64, u32) {
+    best.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    best.truncate(k);
+    best[k - 1]
 }
 
 /// The k nearest t0 points of every t1 point's query centre, as a flat row-major array
@@ -223,7 +231,7 @@ pub(crate) fn knn(
         .enumerate()
         .with_min_len(256)
         .for_each_init(
-            || (Vec::with_capacity(k + 1), Vec::with_capacity(k)),
+            || (Vec::with_capacity(2 * k), Vec::with_capacity(k)),
             |(found, row), (p, (cc, cs))| {
                 grid.nearest(&centres[p], k, found);
                 row.clear();
@@ -533,6 +541,7 @@ mod tests {
                 for k in [1, 3, 24, x0.len()] {
                     let k = k.min(x0.len());
                     grid.nearest(&q, k, &mut best);
+                    best.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                     let mut all: Vec<(f64, u32)> = x0
                         .iter()
                         .enumerate()
