@@ -604,9 +604,12 @@ fn sparse(
         // Every violation is a new edge (candidate edges cannot violate), so the graph
         // grows strictly each round and the loop ends, at worst with all n² pairs.
         added += check.violations.len();
+        // The violations come sorted by row.
+        let mut touched: Vec<usize> = check.violations.iter().map(|e| e.0 as usize).collect();
+        touched.dedup();
         extras = merge(extras, check.violations);
         graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
-        let freed = lap.restore_invariant(&graph);
+        let freed = lap.restore_invariant_on(&graph, touched);
         trace!(t, "round {rounds}: {freed} rows freed");
     };
 
