@@ -508,7 +508,9 @@ fn sparse(
         }
         let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
         // A throwaway memo: these potentials satisfy ε-CS only, so a pass may also
-        // return candidate edges (dropped by the merge) and proves nothing.
+        // return candidate edges (dropped by the merge). Its bounds would hold later too,
+        // but carried over with the slack they made these passes search further while
+        // round 1 still re-examined every row (docs/benchmarks.md).
         let check = certificate::check(
             wtree,
             x1,
