@@ -25,6 +25,7 @@
 
 use rayon::prelude::*;
 
+use super::candidates::Graph;
 use super::cost::{dist2, CostScale};
 use super::sparse_lap::Lap;
 
@@ -33,7 +34,7 @@ use super::sparse_lap::Lap;
 /// progress, while a row on an expensive edge cannot flood the graph.
 pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree.
-const LEAF: usize = 16;
+const LEAF: usize = 32;
 /// Relative safety margin on `R_p` and the bounds: floating-point distances and the
 /// conversion of potentials to lengths err by ~1e-16 relative, far below this.
 const REL_MARGIN: f64 = 1e-9;
@@ -50,18 +51,36 @@ struct Node {
     right: u32,
 }
 
+/// Lower bounds of `d(p, q) + W_q` over a node's points, from per-node minima of the
+/// weights `W` (refreshed for every certificate pass, as `v` changes).
+#[derive(Clone, Copy, Debug)]
+struct Bounds {
+    /// Slope bound along the bed's long axis `a` (the root's widest): `[s, e, m]` with
+    /// `s` the node's least-squares slope of `W` against `x_a`, `e = sqrt(1 − s²)` and
+    /// `m = min(W − s·x_a)`. Since `d(p, q) >= s·(p_a − q_a) + e·L` for `L` the
+    /// distance across the axis (Cauchy–Schwarz, `s² + e² <= 1`), `d + W_q >= s·p_a +
+    /// e·L_min + m`. Where `W` slopes along the axis almost as steeply as the cost
+    /// itself (`|s|` near 1: a long drum whose particles drift along its axis), the
+    /// set `d + W < r` is a long thin ellipsoid along the axis, whose width the axis
+    /// bounds of `lin` (`e = 0`) do not see.
+    slope: [f64; 3],
+    /// Minimum of `W`: `d + W_q >= mindist(p, box) + min W`.
+    min: f64,
+    /// Minima of `W − x_a` (`[0..3]`) and `W + x_a` (`[3..6]`) per axis `a`: since
+    /// `d(p, q) >= ±(p_a − q_a)`, `d + W_q >= p_a + min(W − x_a)` and `>= −p_a +
+    /// min(W + x_a)`.
+    lin: [f64; 6],
+}
+
 /// A static k-d tree over the t0 points (built once per pairing), with per-node minima
 /// of the weights `W` (refreshed for every certificate pass, as `v` changes).
 pub(crate) struct WeightedTree {
     nodes: Vec<Node>,
-    /// Node minima of `W`, parallel to `nodes`.
-    wmin: Vec<f64>,
-    /// Node minima of `W − x_a` (`[0..3]`) and `W + x_a` (`[3..6]`) per axis `a`,
-    /// parallel to `nodes`: since `d(p, q) >= ±(p_a − q_a)`, `d + W_q >= p_a +
-    /// min(W − x_a)` and `>= −p_a + min(W + x_a)`. Where the potentials slope along
-    /// the bed (a long drum whose particles drift along its axis), these bounds prune
-    /// the nodes far along the slope that `mindist + W_min` cannot.
-    wlin: Vec<[f64; 6]>,
+    /// The weight bounds of each node, parallel to `nodes` (one record per node: the
+    /// search reads them together).
+    bounds: Vec<Bounds>,
+    /// The long axis of [`Bounds::slope`].
+    axis: usize,
     /// Points and their t0 indices, in tree order (leaves contiguous).
     pts: Vec<[f64; 3]>,
     idx: Vec<u32>,
@@ -78,10 +97,21 @@ impl WeightedTree {
         build(x0, &mut idx, 0, &mut nodes);
         let pts = idx.iter().map(|&i| x0[i as usize]).collect();
         let n = nodes.len();
+        let root: &Node = &nodes[0];
+        let axis = (0..3)
+            .max_by(|&a, &b| (root.hi[a] - root.lo[a]).total_cmp(&(root.hi[b] - root.lo[b])))
+            .unwrap_or(0);
         Self {
             nodes,
-            wmin: vec![0.0; n],
-            wlin: vec![[0.0; 6]; n],
+            bounds: vec![
+                Bounds {
+                    slope: [0.0, 1.0, 0.0],
+                    min: 0.0,
+                    lin: [0.0; 6],
+                };
+                n
+            ],
+            axis,
             pts,
             idx,
             w: vec![0.0; x0.len()],
@@ -107,20 +137,56 @@ impl WeightedTree {
                         lin[a + 3] = lin[a + 3].min(w + x[a]);
                     }
                 }
-                self.wmin[i] = m;
-                self.wlin[i] = lin;
+                self.bounds[i].min = m;
+                self.bounds[i].lin = lin;
             } else {
-                let (l, r) = (nd.left as usize, nd.right as usize);
-                self.wmin[i] = self.wmin[l].min(self.wmin[r]);
-                let (a, b) = (self.wlin[l], self.wlin[r]);
-                self.wlin[i] = std::array::from_fn(|j| a[j].min(b[j]));
+                let (l, r) = (
+                    &self.bounds[nd.left as usize],
+                    &self.bounds[nd.right as usize],
+                );
+                let m = l.min.min(r.min);
+                let lin = std::array::from_fn(|j| l.lin[j].min(r.lin[j]));
+                self.bounds[i].min = m;
+                self.bounds[i].lin = lin;
             }
         }
+        let (axis, w, pts) = (self.axis, &self.w, &self.pts);
+        self.nodes
+            .par_iter()
+            .zip(self.bounds.par_iter_mut())
+            .with_min_len(64)
+            .for_each(|(nd, bounds)| {
+                let range = nd.start as usize..nd.end as usize;
+                let len = range.len() as f64;
+                let (mut sx, mut sw) = (0.0, 0.0);
+                for t in range.clone() {
+                    sx += pts[t][axis];
+                    sw += w[t];
+                }
+                let (mx, mw) = (sx / len, sw / len);
+                let (mut sxx, mut sxw) = (0.0, 0.0);
+                for t in range.clone() {
+                    let dx = pts[t][axis] - mx;
+                    sxx += dx * dx;
+                    sxw += dx * (w[t] - mw);
+                }
+                let s = if sxx > 0.0 {
+                    (sxw / sxx).clamp(-1.0, 1.0)
+                } else {
+                    0.0
+                };
+                // Rounding could make s² + e² exceed 1 by an ulp; shrink e instead.
+                let e = (1.0 - s * s).max(0.0).sqrt() * (1.0 - 1e-12);
+                let m = range
+                    .map(|t| w[t] - s * pts[t][axis])
+                    .fold(f64::INFINITY, f64::min);
+                bounds.slope = [s, e, m];
+            });
     }
 
     /// Calls `visit(tree position)` for every point with `d + W < r`, skipping every
-    /// node with `mindist(p, box) + W_min >= r` or with one of the axis bounds of
-    /// `wlin` at least `r`. `stack` is scratch. Both tests are
+    /// node one of whose [`Bounds`] is at least `r` (the slope bound first: on a long
+    /// drum it prunes the most). `stack` is scratch. The tests involving distances are
     /// made on squares (`d < r − W` with `r − W > 0`), without square roots; the
     /// rounding of either form is far below the margin built into `r`.
     fn search(&self, p: &[f64; 3], r: f64, stack: &mut Vec<u32>, mut visit: impl FnMut(usize)) {
@@ -128,12 +194,23 @@ impl WeightedTree {
         stack.push(0);
         while let Some(i) = stack.pop() {
             let i = i as usize;
-            let nd = &self.nodes[i];
-            let reach = r - self.wmin[i];
-            if reach <= 0.0 || mindist2(p, &nd.lo, &nd.hi) >= reach * reach {
+            let (nd, b) = (&self.nodes[i], &self.bounds[i]);
+            // Squared gaps from p to the box per axis, shared by the two box bounds.
+            let gap2: [f64; 3] = std::array::from_fn(|a| {
+                let d = (nd.lo[a] - p[a]).max(p[a] - nd.hi[a]).max(0.0);
+                d * d
+            });
+            let across: f64 = (0..3).filter(|&a| a != self.axis).map(|a| gap2[a]).sum();
+            let [s, e, m] = b.slope;
+            let rest = r - s * p[self.axis] - m;
+            if rest <= 0.0 || e * e * across >= rest * rest {
                 continue;
             }
-            let lin = &self.wlin[i];
+            let reach = r - b.min;
+            if reach <= 0.0 || across + gap2[self.axis] >= reach * reach {
+                continue;
+            }
+            let lin = &b.lin;
             if (0..3).any(|a| p[a] + lin[a] >= r || lin[a + 3] - p[a] >= r) {
                 continue;
             }
@@ -190,17 +267,6 @@ fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>)
     me as u32
 }
 
-/// Squared distance from `p` to the box `[lo, hi]` (0 inside).
-#[inline]
-fn mindist2(p: &[f64; 3], lo: &[f64; 3], hi: &[f64; 3]) -> f64 {
-    let mut s = 0.0;
-    for a in 0..3 {
-        let d = (lo[a] - p[a]).max(p[a] - hi[a]).max(0.0);
-        s += d * d;
-    }
-    s
-}
-
 /// Outcome of one certificate pass.
 pub(crate) struct Check {
     /// Violating pairs (row, column), sorted.
@@ -212,32 +278,52 @@ pub(crate) struct Check {
 /// What the previous passes proved, so that a pass only re-examines the rows where a
 /// violation can have appeared since.
 ///
-/// A pass proves, for every row `p` it examines, `c(p, q) >= u[p] + v[q]` for every
-/// column `q` it does not return (unless it returned more than
-/// [`MAX_ADDED_PER_ROW`]: then the row is examined again next time). The returned
-/// pairs join the candidate graph, where the solver keeps them non-violating. The pair
-/// inequality can only break again if `u[p] + v[q]` grows. Column potentials never
-/// increase in this solver (augmentations and auction bids only lower them; this is
-/// checked, and a full pass is made if it ever fails), so a row needs examining again
-/// only if its own `u[p]` grew since its last examination.
-#[derive(Default)]
+/// A pass that examines row `p` proves a lower bound `b[p]` of `c(p, q) − v[q]` over
+/// every column `q` that is neither a candidate edge of `p` nor returned (unless it
+/// returned more than [`MAX_ADDED_PER_ROW`]: then the row is examined again next
+/// time). Its search reaches `slack` units beyond the violations (`c − v < u[p] +
+/// slack`): every column it does not reach has `c − v >= u[p] + slack`, and the ones
+/// it reaches give their exact `c − v`. Candidate edges and returned pairs stay in the
+/// graph, where the solver keeps them non-violating. Column potentials never increase
+/// in this solver (augmentations and auction bids only lower them; this is checked, and
+/// a full pass is made if it ever fails), so `c − v` only grows and the bound still
+/// holds later: the row needs examining again only once its own `u[p]` exceeds `b[p]`.
+/// With `slack = 0` that is as soon as `u[p]` grew at all since its last examination;
+/// a small slack spares the rows whose `u` a repair solve raises by a little, for a
+/// slightly larger search.
 pub(crate) struct Memo {
-    /// `u[p]` when row `p` was last examined (`i64::MIN`: never).
-    u: Vec<i64>,
+    /// `b[p]` (`i64::MIN`: never examined).
+    bound: Vec<i64>,
     /// `v[q]` at the last pass.
     v: Vec<i64>,
     /// Row returned more than `MAX_ADDED_PER_ROW` violations: examine again.
     again: Vec<bool>,
+    /// How far beyond the violations a search reaches, in cost units (>= 0).
+    slack: i64,
+}
+
+impl Memo {
+    /// Nothing proven yet; searches reach `slack` cost units beyond the violations.
+    pub(crate) fn new(slack: i64) -> Self {
+        Self {
+            bound: Vec::new(),
+            v: Vec::new(),
+            again: Vec::new(),
+            slack: slack.max(0),
+        }
+    }
 }
 
 /// One certificate pass (in parallel over rows, results collected in row order).
-/// `lap` must hold a perfect matching that satisfies the invariant on the current
-/// candidate graph. `memo` carries what earlier passes proved (start with
-/// `Memo::default()`); rows that cannot have gained a violation since are skipped.
+/// `lap` must hold a perfect matching that satisfies the invariant on the candidate
+/// graph `graph`, or ε-CS on it (a pass on the auction's potentials: it may then also
+/// return candidate edges). `memo` carries what earlier passes proved (start with
+/// [`Memo::new`]); rows that cannot have gained a violation since are skipped.
 pub(crate) fn check(
     tree: &mut WeightedTree,
     x1: &[[f64; 3]],
     lap: &Lap,
+    graph: &Graph,
     scale: &CostScale,
     memo: &mut Memo,
 ) -> Check {
@@ -246,7 +332,7 @@ pub(crate) fn check(
     // The skip rule needs every column potential to be at most what it was at the
     // previous pass; otherwise forget everything and examine all rows.
     if memo.v.len() != n || memo.v.iter().zip(&v_now).any(|(old, new)| new > old) {
-        memo.u = vec![i64::MIN; n];
+        memo.bound = vec![i64::MIN; n];
         memo.again = vec![true; n];
     }
     memo.v = v_now;
@@ -254,28 +340,36 @@ pub(crate) fn check(
     let unit = scale.unit();
     tree.set_weights(|q| lap.v(q), v_max, unit);
     let tree = &*tree;
-    let (memo_u, memo_again) = (&memo.u, &memo.again);
-    let per_row: Vec<(Vec<u32>, u64, bool)> = (0..n)
+    let (memo_bound, memo_again, slack) = (&memo.bound, &memo.again, memo.slack);
+    // Per row: the returned columns, the points examined, whether the list was
+    // truncated, and the row's new bound (`None`: not examined, the old one holds).
+    let per_row: Vec<(Vec<u32>, u64, bool, Option<i64>)> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map_init(Vec::new, |stack, p| {
             let u = lap.u(p);
-            if !memo_again[p] && u <= memo_u[p] {
-                return (Vec::new(), 0, false); // proven at an earlier pass, still holds
+            if !memo_again[p] && u <= memo_bound[p] {
+                return (Vec::new(), 0, false, None); // proven at an earlier pass, still holds
             }
             if u + v_max <= 0 {
-                // c >= 0 and v <= v_max: nothing can undercut.
-                return (Vec::new(), 0, false);
+                // c >= 0 and v <= v_max: c − v >= −v_max >= u for every column.
+                return (Vec::new(), 0, false, Some(-v_max));
             }
-            let r = ((u + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
+            // Every column with c − v <= u + slack − 1 has d + W < r (the module
+            // documentation's argument, with u + slack for u).
+            let r = ((u + slack + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
             let mut bad: Vec<(i64, u32)> = Vec::new();
+            let mut near = slack;
             let mut examined = 0u64;
+            let edges = graph.row(p).0;
             tree.search(&x1[p], r, stack, |t| {
                 examined += 1;
-                let q = tree.idx[t] as usize;
-                let reduced = scale.cost(&x1[p], &tree.pts[t]) - u - lap.v(q);
+                let q = tree.idx[t];
+                let reduced = scale.cost(&x1[p], &tree.pts[t]) - u - lap.v(q as usize);
                 if reduced < 0 {
-                    bad.push((reduced, q as u32));
+                    bad.push((reduced, q));
+                } else if reduced < near && !edges.contains(&q) {
+                    near = reduced;
                 }
             });
             let truncated = bad.len() > MAX_ADDED_PER_ROW;
@@ -283,16 +377,16 @@ pub(crate) fn check(
             bad.truncate(MAX_ADDED_PER_ROW);
             let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
             cols.sort_unstable();
-            (cols, examined, truncated)
+            (cols, examined, truncated, Some(u + near))
         })
         .collect();
     let mut violations = Vec::new();
     let mut examined = 0;
-    for (p, (bad, m, truncated)) in per_row.into_iter().enumerate() {
-        if memo.again[p] || lap.u(p) > memo.u[p] {
-            memo.u[p] = lap.u(p); // examined in this pass
+    for (p, (bad, m, truncated, bound)) in per_row.into_iter().enumerate() {
+        if let Some(b) = bound {
+            memo.bound[p] = b;
+            memo.again[p] = truncated;
         }
-        memo.again[p] = truncated;
         examined += m;
         violations.extend(bad.into_iter().map(|q| (p as u32, q)));
     }

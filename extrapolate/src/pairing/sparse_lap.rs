@@ -223,8 +223,19 @@ impl Lap {
     /// invariant without touching `v`; the freed rows are re-augmented by [`Lap::solve`].
     /// Returns how many rows were freed.
     pub(crate) fn restore_invariant(&mut self, g: &Graph) -> usize {
+        self.restore_invariant_on(g, 0..g.rows())
+    }
+
+    /// [`Lap::restore_invariant`] on the given rows only: after a solve the invariant
+    /// holds on every row, so a repair round need only look at the rows that gained
+    /// edges (a few thousand of 80 000 on the long kiln).
+    pub(crate) fn restore_invariant_on(
+        &mut self,
+        g: &Graph,
+        rows: impl IntoIterator<Item = usize>,
+    ) -> usize {
         let mut freed = 0;
-        for p in 0..g.rows() {
+        for p in rows {
             let q0 = self.col_of_row[p];
             if q0 == NONE {
                 continue;
