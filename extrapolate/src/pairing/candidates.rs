@@ -515,13 +515,7 @@ mod tests {
     /// flat one, a line and a lattice with exact ties.
     #[test]
     fn grid_nearest_matches_brute_force() {
-        let mut s = 77u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = super::super::test_uniform(77);
         let bulk: Vec<[f64; 3]> = (0..900).map(|_| [rnd(), 3.0 * rnd(), rnd()]).collect();
         let flat: Vec<[f64; 3]> = (0..300).map(|_| [rnd(), rnd(), 0.5]).collect();
         let line: Vec<[f64; 3]> = (0..200).map(|_| [0.0, 10.0 * rnd(), 0.0]).collect();

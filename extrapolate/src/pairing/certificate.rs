@@ -403,13 +403,7 @@ mod tests {
     /// The weighted search returns exactly the brute-force set {q : d + W_q < r}.
     #[test]
     fn weighted_search_matches_brute_force() {
-        let mut s = 12345u64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rnd = super::super::test_uniform(12345);
         let x0: Vec<[f64; 3]> = (0..700).map(|_| [rnd(), rnd(), 2.0 * rnd()]).collect();
         // Potentials sloping along z, gently and (as in a long drum whose particles
         // drift along its axis) nearly as steeply as the cost itself, where the axis

@@ -663,6 +663,19 @@ fn merge(a: Vec<(u32, u32)>, mut b: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
     out
 }
 
+/// The tests' random beds: a xorshift64 stream of uniform numbers in [0, 1) from a fixed
+/// seed, so that every run builds the same bed.
+#[cfg(test)]
+fn test_uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

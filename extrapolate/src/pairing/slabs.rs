@@ -261,13 +261,8 @@ mod tests {
     /// solver cuts it into slabs and reaches the same certified optimum as without them.
     #[test]
     fn slabs_reach_the_optimum_of_the_whole_bed() {
-        let mut s = 0x2545f4914f6cdd1du64;
-        let mut rnd = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 11) as f64 / (1u64 << 53) as f64 - 0.5
-        };
+        let mut uniform = super::super::test_uniform(0x2545f4914f6cdd1d);
+        let mut rnd = || uniform() - 0.5;
         let n = 6400;
         let site = |i: usize| [(i % 4) as f64, ((i / 4) % 4) as f64, (i / 16) as f64];
         let x0: Vec<[f64; 3]> = (0..n)
