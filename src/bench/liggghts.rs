@@ -192,7 +192,9 @@ fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> 
         tdex_format::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
     }
     let axis = split_axis.index();
-    let ext = if axis == 1 { l / 2.0 + 0.01 } else { r + 0.01 };
+    // The split plane's extent along its axis: the box's half-width on that axis.
+    let (across, along) = box_half_widths(case);
+    let ext = if axis == 1 { along } else { across };
     let block = |upper: &str| {
         let mut b = ["INF"; 6];
         b[2 * axis + 1] = upper;
