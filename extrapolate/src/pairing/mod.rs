@@ -299,6 +299,15 @@ const AUCTION_REFINE: i64 = 16;
 /// auction finer").
 const AUCTION_RESUME: i64 = 256;
 
+/// The certificate searches on the auction's potentials return up to this many
+/// violating pairs per row (the exact repair rounds: `certificate::MAX_ADDED_PER_ROW`,
+/// 8). The auction absorbs them cheaply, and on the long kiln the rows it leaves
+/// violated otherwise surface again, one round at a time, in the exact phase: with 8
+/// its solves scanned 1.04·10⁶ columns in 6 rounds, with 32 0.37·10⁶ in 5 (with 32 in
+/// every pass too: 4 rounds, no faster). The pilot drum's rows have fewer violations:
+/// nothing changes there (docs/benchmarks.md, "Resuming the auction finer").
+const AUCTION_PAIRS_PER_ROW: usize = 32;
+
 /// `TDEX_PAIR_TRACE` set: phase timings and counters of the sparse solver on stderr
 /// (diagnostics only; the result does not depend on it).
 fn trace_on() -> bool {
@@ -529,7 +538,7 @@ fn sparse(
             &lap,
             &graph,
             scale,
-            &mut certificate::Memo::new(0),
+            &mut certificate::Memo::new(0, AUCTION_PAIRS_PER_ROW),
         );
         examined += check.examined;
         trace!(
@@ -566,7 +575,7 @@ fn sparse(
     // pause ε (1/16 of the mean cheapest pair cost times two). On the long kiln this
     // spares rows whose `u` a repair solve raised by less: 7 % of the certificate's
     // time (slack 0: 0.78 s, 2^14 or 2^16 units: 0.72 s).
-    let mut memo = certificate::Memo::new(eps0 / AUCTION_REFINE);
+    let mut memo = certificate::Memo::new(eps0 / AUCTION_REFINE, certificate::MAX_ADDED_PER_ROW);
     let mut rounds = 0u32;
     let mut grown = 0usize;
     let certified = loop {
