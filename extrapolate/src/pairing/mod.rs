@@ -295,8 +295,8 @@ const AUCTION_REFINE: i64 = 16;
 /// a new edge undercuts by more than that are freed and bid in finer phases, where
 /// resuming at the pause ε re-ran its coarse phase over the whole bed. On the long kiln
 /// 6.2·10⁶ bids instead of 8.2·10⁶, on the pilot drum 3.5·10⁶ instead of 4.3·10⁶ and 2
-/// exact rounds instead of 3; the same pairings (docs/benchmarks.md, "Resuming the
-/// auction finer").
+/// exact rounds instead of 3; the same pairings (docs/benchmarks.md, "Pairing the long
+/// kiln: resuming the auction finer").
 const AUCTION_RESUME: i64 = 256;
 
 /// The certificate searches on the auction's potentials return up to this many
@@ -304,8 +304,8 @@ const AUCTION_RESUME: i64 = 256;
 /// 8). The auction absorbs them cheaply, and on the long kiln the rows it leaves
 /// violated otherwise surface again, one round at a time, in the exact phase: with 8
 /// its solves scanned 1.04·10⁶ columns in 6 rounds, with 32 0.37·10⁶ in 5 (with 32 in
-/// every pass too: 4 rounds, no faster). The pilot drum's rows have fewer violations:
-/// nothing changes there (docs/benchmarks.md, "Resuming the auction finer").
+/// every pass too: 4 rounds, no faster). The pilot drum's counts do not change
+/// (docs/benchmarks.md, "Pairing the long kiln: resuming the auction finer").
 const AUCTION_PAIRS_PER_ROW: usize = 32;
 
 /// `TDEX_PAIR_TRACE` set: phase timings and counters of the sparse solver on stderr
