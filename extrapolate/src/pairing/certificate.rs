@@ -29,9 +29,11 @@ use super::candidates::Graph;
 use super::cost::{dist2, CostScale};
 use super::sparse_lap::Lap;
 
-/// At most this many violating pairs per row are returned (the most negative reduced
-/// costs). Every violating row still gains an edge, so repair rounds still make
-/// progress, while a row on an expensive edge cannot flood the graph.
+/// In the exact repair rounds, at most this many violating pairs per row are returned
+/// (the most negative reduced costs). Every violating row still gains an edge, so
+/// repair rounds still make progress, while a row on an expensive edge cannot flood
+/// the graph. (The searches on the auction's potentials return more: see
+/// `AUCTION_PAIRS_PER_ROW` in the parent module.)
 pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree.
 const LEAF: usize = 32;
@@ -280,7 +282,7 @@ pub(crate) struct Check {
 ///
 /// A pass that examines row `p` proves a lower bound `b[p]` of `c(p, q) − v[q]` over
 /// every column `q` that is neither a candidate edge of `p` nor returned (unless it
-/// returned more than [`MAX_ADDED_PER_ROW`]: then the row is examined again next
+/// returned more than its limit of pairs per row: then the row is examined again next
 /// time). Its search reaches `slack` units beyond the violations (`c − v < u[p] +
 /// slack`): every column it does not reach has `c − v >= u[p] + slack`, and the ones
 /// it reaches give their exact `c − v`. Candidate edges and returned pairs stay in the
@@ -296,20 +298,24 @@ pub(crate) struct Memo {
     bound: Vec<i64>,
     /// `v[q]` at the last pass.
     v: Vec<i64>,
-    /// Row returned more than `MAX_ADDED_PER_ROW` violations: examine again.
+    /// Row returned more than `per_row` violations: examine again.
     again: Vec<bool>,
     /// How far beyond the violations a search reaches, in cost units (>= 0).
     slack: i64,
+    /// At most this many violating pairs per row are returned (at least 1).
+    per_row: usize,
 }
 
 impl Memo {
-    /// Nothing proven yet; searches reach `slack` cost units beyond the violations.
-    pub(crate) fn new(slack: i64) -> Self {
+    /// Nothing proven yet; searches reach `slack` cost units beyond the violations and
+    /// return at most `per_row` violating pairs per row.
+    pub(crate) fn new(slack: i64, per_row: usize) -> Self {
         Self {
             bound: Vec::new(),
             v: Vec::new(),
             again: Vec::new(),
             slack: slack.max(0),
+            per_row: per_row.max(1),
         }
     }
 }
@@ -340,7 +346,8 @@ pub(crate) fn check(
     let unit = scale.unit();
     tree.set_weights(|q| lap.v(q), v_max, unit);
     let tree = &*tree;
-    let (memo_bound, memo_again, slack) = (&memo.bound, &memo.again, memo.slack);
+    let (memo_bound, memo_again, slack, limit) =
+        (&memo.bound, &memo.again, memo.slack, memo.per_row);
     // Per row: the returned columns, the points examined, whether the list was
     // truncated, and the row's new bound (`None`: not examined, the old one holds).
     let per_row: Vec<(Vec<u32>, u64, bool, Option<i64>)> = (0..n)
@@ -372,9 +379,9 @@ pub(crate) fn check(
                     near = reduced;
                 }
             });
-            let truncated = bad.len() > MAX_ADDED_PER_ROW;
+            let truncated = bad.len() > limit;
             bad.sort_unstable();
-            bad.truncate(MAX_ADDED_PER_ROW);
+            bad.truncate(limit);
             let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
             cols.sort_unstable();
             (cols, examined, truncated, Some(u + near))
