@@ -480,21 +480,24 @@ fn auction_phases(
 
 /// Mean cost of the rows' cheapest candidates (at least 0).
 pub(crate) fn mean_cheapest(g: &Graph) -> f64 {
-    let rows = g.rows().max(1);
-    let sum: i128 = (0..g.rows())
+    let (sum, rows) = cheapest_sum(g);
+    sum as f64 / rows as f64
+}
+
+/// The sum over rows of each row's cheapest candidate cost, and the row count (at least
+/// 1, so that an empty graph divides safely): the one pass both the mean and ε₀ need.
+fn cheapest_sum(g: &Graph) -> (i128, usize) {
+    let sum = (0..g.rows())
         .map(|p| g.row(p).1.iter().copied().min().unwrap_or(0) as i128)
         .sum();
-    sum as f64 / rows as f64
+    (sum, g.rows().max(1))
 }
 
 /// Initial ε of the auction: the power of two nearest to twice the mean cost of the
 /// rows' cheapest candidates (a million units, one diameter at the default unit, on a
 /// packed bed), at least 1.
 pub(crate) fn initial_eps(g: &Graph) -> i64 {
-    let rows = g.rows().max(1);
-    let sum: i128 = (0..g.rows())
-        .map(|p| g.row(p).1.iter().copied().min().unwrap_or(0) as i128)
-        .sum();
+    let (sum, rows) = cheapest_sum(g);
     let target = (2 * sum / rows as i128).max(1) as u64;
     let up = target.next_power_of_two();
     let eps = if up - target > target - up / 2 {
