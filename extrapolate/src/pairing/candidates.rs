@@ -196,13 +196,19 @@ impl Grid {
 
 /// The order of the nearest: squared distance, ties to the lower index.
 #[inline]
+fn order(a: &(f64, u32), b: &(f64, u32)) -> std::cmp::Ordering {
+    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+}
+
+/// `a` comes before `b` in [`order`].
+#[inline]
 fn nearer(a: &(f64, u32), b: &(f64, u32)) -> bool {
-    a.0 < b.0 || (a.0 == b.0 && a.1 < b.1)
+    order(a, b).is_lt()
 }
 
 /// Cuts `best` (at least k entries) back to its k nearest; returns the k-th.
 fn keep_nearest(best: &mut Vec<(f64, u32)>, k: usize) -> (f64, u32) {
-    best.select_nth_unstable_by(k - 1, |a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    best.select_nth_unstable_by(k - 1, order);
     best.truncate(k);
     best[k - 1]
 }

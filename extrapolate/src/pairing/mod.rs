@@ -637,10 +637,10 @@ fn sparse(
         trace!(t, "round {rounds}: {freed} rows freed");
     };
 
+    let total_cost = lap.mcost.iter().sum();
     trace!(
         t,
-        "total cost {}, {bids} bids, {} columns scanned, {examined} examined",
-        lap.mcost.iter().sum::<i64>(),
+        "total cost {total_cost}, {bids} bids, {} columns scanned, {examined} examined",
         lap.work
     );
     // Back to the caller's numbering.
@@ -649,7 +649,7 @@ fn sparse(
         g[perm1[p] as usize] = perm0[q as usize];
     }
     let pairing = Pairing {
-        total_cost: lap.mcost.iter().sum(),
+        total_cost,
         total_distance: total_distance(x0_in, x1_in, &g),
         g,
         k_used: k0,
