@@ -43,7 +43,8 @@ pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
 /// `t1`. Its summary carries the solve's time and thread count.
 pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, ExtrapolateError> {
     let d = t0.mean_diameter();
-    let p = pairing::pair(&t0.pos, &t1.pos, &PairingOptions::for_diameter(d))?;
+    let opts = PairingOptions::for_bed(d, &t0.pos, &t1.pos);
+    let p = pairing::pair(&t0.pos, &t1.pos, &opts)?;
     Ok(StoredPairing {
         snapshots_fingerprint: fingerprint(t0, t1),
         summary: PairingSummary {

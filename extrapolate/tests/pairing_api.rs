@@ -199,6 +199,41 @@ fn dense_max_switches_to_the_oracle() {
     assert!(mean > 0.0 && mean < 1.0, "{mean}");
 }
 
+/// A bed 10 000 diameters long: a millionth of a diameter would give pair costs beyond 32
+/// bits, which `pair` refuses; `for_bed` coarsens the unit just enough, and the sparse
+/// solver then reaches the dense oracle's optimum at that unit.
+#[test]
+fn a_bed_too_long_for_a_millionth_of_a_diameter_gets_a_coarser_unit() {
+    let mut rng = Rng::new(11);
+    let n = 240;
+    // a line of clusters along x, 10 000 diameters of 0.01 from end to end
+    let x0: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let x = (i / 8) as f64 * 100.0 / (n / 8 - 1) as f64;
+            [x + 0.01 * rng.f64(), 0.02 * rng.f64(), 0.02 * rng.f64()]
+        })
+        .collect();
+    let x1 = rejitter(&x0, 0.008, &mut rng);
+    let fine = PairingOptions::for_diameter(0.01);
+    assert!(matches!(
+        pair(&x0, &x1, &fine).unwrap_err(),
+        PairingError::CostOverflow { .. }
+    ));
+    let opts = PairingOptions::for_bed(0.01, &x0, &x1);
+    assert!(
+        opts.unit > fine.unit && opts.unit < 3.0 * fine.unit,
+        "{}",
+        opts.unit
+    );
+    let sparse = pair(&x0, &x1, &opts).unwrap();
+    assert!(sparse.certified);
+    let dense = pair_dense(&x0, &x1, opts.unit).unwrap();
+    assert_eq!(sparse.total_cost, dense.total_cost);
+    // on a short bed `for_bed` is `for_diameter`
+    let short: Vec<[f64; 3]> = x0.iter().map(|p| [p[0] * 1e-3, p[1], p[2]]).collect();
+    assert_eq!(PairingOptions::for_bed(0.01, &short, &short), fine);
+}
+
 /// Same bytes whatever the number of threads (the parallel parts collect in row order).
 #[test]
 fn result_does_not_depend_on_thread_count() {

@@ -7,7 +7,7 @@
 use kiddo::ImmutableKdTree;
 use rayon::prelude::*;
 
-use super::cost::{dist2, CostScale};
+use super::cost::{dist2, CostScale, EdgeCost};
 
 /// k-d tree over t0 positions (the exit edges' nearest-one queries); items are t0
 /// indices.
@@ -225,11 +225,11 @@ pub(crate) fn knn(
     centres: &[[f64; 3]],
     k: usize,
     scale: &CostScale,
-) -> (Vec<u32>, Vec<i64>) {
+) -> (Vec<u32>, Vec<EdgeCost>) {
     let n = x1.len();
     let k = k.clamp(1, x0.len());
     let mut cols = vec![0u32; n * k];
-    let mut costs = vec![0i64; n * k];
+    let mut costs: Vec<EdgeCost> = vec![0; n * k];
     // Each row writes only its own k-slot chunk: embarrassingly parallel and
     // deterministic (no collection order to worry about).
     cols.par_chunks_mut(k)
@@ -244,7 +244,7 @@ pub(crate) fn knn(
                 row.extend(
                     found
                         .iter()
-                        .map(|&(_, q)| (scale.cost(&x1[p], &x0[q as usize]), q)),
+                        .map(|&(_, q)| (scale.edge_cost(&x1[p], &x0[q as usize]), q)),
                 );
                 row.sort_unstable();
                 debug_assert_eq!(row.len(), k);
@@ -279,7 +279,7 @@ pub(crate) fn mean_cheapest_sampled(
     let k = k.clamp(1, x0.len());
     let (_, costs) = knn(grid, x0, &rows, &row_centres, k, scale);
     // Each row's entries are sorted by cost: the first is its cheapest.
-    let sum: i128 = costs.chunks(k).map(|row| row[0] as i128).sum();
+    let sum: u64 = costs.chunks(k).map(|row| u64::from(row[0])).sum();
     sum as f64 / rows.len().max(1) as f64
 }
 
@@ -415,10 +415,29 @@ impl Axial {
 pub(crate) struct Graph {
     pub(crate) offsets: Vec<usize>,
     pub(crate) cols: Vec<u32>,
-    pub(crate) costs: Vec<i64>,
+    pub(crate) costs: Vec<EdgeCost>,
+    /// The arrays [`Graph::insert`] writes the next graph into, then swaps in: their
+    /// allocations are kept, since fresh ones (24 MB at 80 000 rows and k = 32) cost
+    /// more in page faults than the copy itself.
+    spare_cols: Vec<u32>,
+    spare_costs: Vec<EdgeCost>,
 }
 
 impl Graph {
+    /// The graph of the kNN lists (`k` entries per row, as [`knn`] returns them), taking
+    /// their arrays over.
+    pub(crate) fn from_knn(k: usize, knn_cols: Vec<u32>, knn_costs: Vec<EdgeCost>) -> Self {
+        debug_assert_eq!(knn_cols.len(), knn_costs.len());
+        let rows = knn_cols.len() / k.max(1);
+        Self {
+            offsets: (0..=rows).map(|p| p * k).collect(),
+            cols: knn_cols,
+            costs: knn_costs,
+            spare_cols: Vec::new(),
+            spare_costs: Vec::new(),
+        }
+    }
+
     /// Number of rows.
     pub(crate) fn rows(&self) -> usize {
         self.offsets.len() - 1
@@ -431,54 +450,73 @@ impl Graph {
 
     /// The edges of row `p`: columns and costs.
     #[inline]
-    pub(crate) fn row(&self, p: usize) -> (&[u32], &[i64]) {
+    pub(crate) fn row(&self, p: usize) -> (&[u32], &[EdgeCost]) {
         let (a, b) = (self.offsets[p], self.offsets[p + 1]);
         (&self.cols[a..b], &self.costs[a..b])
     }
 
-    /// Merges the kNN lists and the extra edges (sorted by row then column; they may
-    /// repeat kNN entries, which are dropped) into one graph without duplicate edges,
-    /// replacing this one in place: the arrays keep their allocations. Every repair
-    /// round rebuilds the graph with a few more edges; fresh arrays (30 MB at 80 000
-    /// rows and k = 32) cost more in page faults than the copy itself (24–36 ms per
-    /// build on the long kiln, 6 ms in place).
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn rebuild(
+    /// Adds `edges` (sorted by row then column; those already in the graph, or repeated,
+    /// are skipped), each appended to its row with its cost; returns how many were new.
+    /// The rows between two touched rows move as one block, and only the new edges are
+    /// costed and looked up in their row: a repair round that adds 18 edges to the long
+    /// kiln's 3·10⁶ costs a copy, where merging every extra edge into the kNN lists again
+    /// cost 7 ms a round.
+    pub(crate) fn insert(
         &mut self,
-        k: usize,
-        knn_cols: &[u32],
-        knn_costs: &[i64],
-        extras: &[(u32, u32)],
+        edges: &[(u32, u32)],
         x0: &[[f64; 3]],
         x1: &[[f64; 3]],
         scale: &CostScale,
-    ) {
-        let n = x1.len();
-        let g = self;
-        g.offsets.clear();
-        g.cols.clear();
-        g.costs.clear();
-        g.offsets.reserve(n + 1);
-        g.cols.reserve(knn_cols.len() + extras.len());
-        g.costs.reserve(knn_cols.len() + extras.len());
-        g.offsets.push(0);
-        let mut e = 0usize;
-        for p in 0..n {
-            let start = g.cols.len();
-            g.cols.extend_from_slice(&knn_cols[p * k..(p + 1) * k]);
-            g.costs.extend_from_slice(&knn_costs[p * k..(p + 1) * k]);
-            while e < extras.len() && extras[e].0 as usize == p {
-                let q = extras[e].1;
-                // Extras of a row are few: a linear scan beats any set structure.
-                if !g.cols[start..].contains(&q) {
-                    g.cols.push(q);
-                    g.costs.push(scale.cost(&x1[p], &x0[q as usize]));
+    ) -> usize {
+        debug_assert!(edges.is_sorted());
+        if edges.is_empty() {
+            return 0;
+        }
+        let n = self.rows();
+        let (mut cols, mut costs) = (
+            std::mem::take(&mut self.spare_cols),
+            std::mem::take(&mut self.spare_costs),
+        );
+        cols.clear();
+        costs.clear();
+        cols.reserve(self.cols.len() + edges.len());
+        costs.reserve(self.cols.len() + edges.len());
+        // Rows [copied, p] move as one block. `offsets` is shifted in place: entries
+        // below `copied` are already the new graph's, the others still the old one's
+        // (which the block copy reads), and the start of every row in the block moves by
+        // the edges added before it.
+        let (mut copied, mut added, mut e) = (0usize, 0usize, 0usize);
+        while e < edges.len() {
+            let p = edges[e].0 as usize;
+            let (a, b) = (self.offsets[copied], self.offsets[p + 1]);
+            cols.extend_from_slice(&self.cols[a..b]);
+            costs.extend_from_slice(&self.costs[a..b]);
+            for r in copied..=p {
+                self.offsets[r] += added;
+            }
+            let row_start = self.offsets[p];
+            while e < edges.len() && edges[e].0 as usize == p {
+                let q = edges[e].1;
+                // A row holds a few dozen edges: a linear scan beats any set structure.
+                if !cols[row_start..].contains(&q) {
+                    cols.push(q);
+                    costs.push(scale.edge_cost(&x1[p], &x0[q as usize]));
+                    added += 1;
                 }
                 e += 1;
             }
-            g.offsets.push(g.cols.len());
+            copied = p + 1;
         }
-        debug_assert_eq!(e, extras.len());
+        let a = self.offsets[copied];
+        cols.extend_from_slice(&self.cols[a..]);
+        costs.extend_from_slice(&self.costs[a..]);
+        for r in copied..=n {
+            self.offsets[r] += added;
+        }
+        debug_assert_eq!(self.offsets[n], cols.len());
+        self.spare_cols = std::mem::replace(&mut self.cols, cols);
+        self.spare_costs = std::mem::replace(&mut self.costs, costs);
+        added
     }
 }
 
@@ -496,23 +534,52 @@ mod tests {
         assert_eq!(&c[..3], &[10, 11, 9]);
         assert_eq!(&w[..3], &[200, 800, 1200]);
         assert_eq!(&c[3..], &[0, 1, 2]);
-        let mut g = Graph::default();
-        g.rebuild(3, &c, &w, &[(1, 2), (1, 30), (1, 40)], &x0, &x1, &scale);
+        let mut g = Graph::from_knn(3, c, w);
+        assert_eq!(g.insert(&[(1, 2), (1, 30), (1, 40)], &x0, &x1, &scale), 2);
         assert_eq!(g.row(0).0, &[10, 11, 9]);
         assert_eq!(g.row(1).0, &[0, 1, 2, 30, 40]);
         assert_eq!(g.row(1).1[4], 43000);
         assert_eq!(g.edges(), 8);
         assert_eq!(g.rows(), 2);
-        // Rebuilt in place, with more rows' extras and then fewer: the same as built anew.
-        let mut h = g;
-        for extras in [&[(0, 40), (1, 2), (1, 30), (1, 40)][..], &[(1, 7)][..]] {
-            h.rebuild(3, &c, &w, extras, &x0, &x1, &scale);
-            let mut fresh = Graph::default();
-            fresh.rebuild(3, &c, &w, extras, &x0, &x1, &scale);
-            assert_eq!(
-                (&h.offsets, &h.cols, &h.costs),
-                (&fresh.offsets, &fresh.cols, &fresh.costs)
-            );
+    }
+
+    /// Edges inserted batch after batch (touching the first row, the last, neighbours,
+    /// repeats, edges already present) give every row its old edges in order, then its
+    /// new ones in the order they came, each once, with its cost.
+    #[test]
+    fn inserted_edges_join_their_rows_once() {
+        let mut rnd = super::super::test_uniform(2024);
+        let (n, k) = (40usize, 4usize);
+        let x0: Vec<[f64; 3]> = (0..n).map(|_| [rnd(), rnd(), rnd()]).collect();
+        let x1: Vec<[f64; 3]> = (0..n).map(|_| [rnd(), rnd(), rnd()]).collect();
+        let scale = CostScale::new(&x0, &x1, 1e-6).unwrap();
+        let (c, w) = knn(&Grid::new(&x0), &x0, &x1, &x1, k, &scale);
+        let mut want: Vec<Vec<u32>> = c.chunks(k).map(<[u32]>::to_vec).collect();
+        let mut g = Graph::from_knn(k, c, w);
+        for batch in 0..30 {
+            let mut edges: Vec<(u32, u32)> = (0..[0, 1, 3, 25][batch % 4])
+                .map(|_| ((rnd() * n as f64) as u32, (rnd() * n as f64) as u32))
+                .collect();
+            if batch % 5 == 1 {
+                edges.extend([(0, 7), (0, 7), (n as u32 - 1, 3), (n as u32 - 1, 3)]);
+            }
+            edges.sort_unstable();
+            let mut added = 0;
+            for &(p, q) in &edges {
+                if !want[p as usize].contains(&q) {
+                    want[p as usize].push(q);
+                    added += 1;
+                }
+            }
+            assert_eq!(g.insert(&edges, &x0, &x1, &scale), added, "batch {batch}");
+            assert_eq!(g.rows(), n);
+            for (p, cols) in want.iter().enumerate() {
+                let (gc, gw) = g.row(p);
+                assert_eq!(gc, &cols[..], "batch {batch}, row {p}");
+                for (&q, &cost) in gc.iter().zip(gw) {
+                    assert_eq!(cost, scale.edge_cost(&x1[p], &x0[q as usize]));
+                }
+            }
         }
     }
 
@@ -577,8 +644,7 @@ mod tests {
         for centres in [x1.clone(), lattice(-1.4)] {
             for k in [1, 4, 24] {
                 let (c, w) = knn(&grid, &x0, &x1, &centres, k, &scale);
-                let mut g = Graph::default();
-                g.rebuild(k, &c, &w, &[], &x0, &x1, &scale);
+                let g = Graph::from_knn(k, c, w);
                 let whole = crate::pairing::sparse_lap::mean_cheapest(&g);
                 let every = mean_cheapest_sampled(&grid, &x0, &x1, &centres, k, 1, &scale);
                 assert_eq!(every, whole, "k {k}");

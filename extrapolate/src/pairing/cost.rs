@@ -7,9 +7,15 @@
 
 use super::PairingError;
 
-/// Largest cost (in units) we accept for a single pair. Keeps every cost exactly
-/// representable in an `f64` and leaves ample headroom in `i64` for sums and potentials.
-const MAX_PAIR_UNITS: f64 = (1u64 << 40) as f64;
+/// Largest cost (in units) we accept for a single pair: a pair cost fits the candidate
+/// graph's 32-bit edge costs ([`EdgeCost`]), is exact in an `f64`, and leaves ample
+/// headroom in `i64` for sums and potentials.
+pub(crate) const MAX_PAIR_UNITS: f64 = u32::MAX as f64;
+
+/// A pair cost as the candidate graph stores it. 32 bits, not 64: the solver's inner
+/// loops stream every edge of a row, and on the long kiln (3·10⁶ edges) 8 bytes per edge
+/// instead of 12 keep the graph inside the 32 MiB last-level cache (docs/benchmarks.md).
+pub(crate) type EdgeCost = u32;
 /// Bound on `n · max_pair_cost`: potentials and path lengths of the assignment solver
 /// are bounded by it, and it must stay far from `i64::MAX` (2^63).
 const MAX_TOTAL_UNITS: f64 = (1u64 << 60) as f64;
@@ -81,6 +87,15 @@ impl CostScale {
     #[inline]
     pub(crate) fn cost(&self, a: &[f64; 3], b: &[f64; 3]) -> i64 {
         self.cost_of_distance(distance(a, b))
+    }
+
+    /// [`CostScale::cost`] as the graph stores it: every pair distance is at most the
+    /// diagonal checked in [`CostScale::new`], so the cost fits.
+    #[inline]
+    pub(crate) fn edge_cost(&self, a: &[f64; 3], b: &[f64; 3]) -> EdgeCost {
+        let c = self.cost(a, b);
+        debug_assert!((0..=i64::from(EdgeCost::MAX)).contains(&c));
+        c as EdgeCost
     }
 }
 

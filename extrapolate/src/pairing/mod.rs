@@ -59,7 +59,9 @@ pub struct PairingOptions {
 
 impl PairingOptions {
     /// Defaults for particles of the given diameter: `unit = diameter · 1e-6`,
-    /// `k_initial = 24`, never dense, certified.
+    /// `k_initial = 24`, never dense, certified. A pair cost must fit 32 bits, so with
+    /// this unit the bed may span at most 4 294 diameters; [`PairingOptions::for_bed`]
+    /// coarsens the unit beyond that.
     #[must_use]
     pub fn for_diameter(diameter: f64) -> Self {
         Self {
@@ -67,6 +69,23 @@ impl PairingOptions {
             k_initial: 24,
             dense_max: 0,
             certify: true,
+        }
+    }
+
+    /// [`PairingOptions::for_diameter`] for these snapshots: the unit is a millionth of a
+    /// diameter, or, on a bed whose joint bounding box is more than 4 294 diameters
+    /// across, that diagonal over `0.999 · (2³² − 1)`, so that every pair cost fits the
+    /// solver's 32-bit edge costs (docs/pairing.md, "Integer costs"). Non-finite
+    /// coordinates leave the unit as it is; [`pair`] reports them.
+    #[must_use]
+    pub fn for_bed(diameter: f64, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
+        let (lo, hi) = order::bounds(x0, x1);
+        let diagonal = cost::distance(&lo, &hi);
+        let opts = Self::for_diameter(diameter);
+        Self {
+            // f64::max ignores a NaN diagonal: the unit stays a millionth of a diameter
+            unit: opts.unit.max(diagonal / (0.999 * cost::MAX_PAIR_UNITS)),
+            ..opts
         }
     }
 }
@@ -410,11 +429,9 @@ fn sparse(
         k_plain
     };
     trace!(t, "sampled mean cheapest pair");
-    let (mut kc, mut kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
+    let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     trace!(t, "knn k {k0}");
-    let mut extras: Vec<(u32, u32)> = Vec::new();
-    let mut graph = candidates::Graph::default();
-    graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
+    let mut graph = candidates::Graph::from_knn(k0, kc, kw);
     let rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
     trace!(
         t,
@@ -449,7 +466,10 @@ fn sparse(
         None
     };
     let slab_count = cut.as_ref().map_or(1, slabs::Slabs::count);
-    let (mut lap, mut bids) = if let Some(cut) = cut {
+    // The certificate's tree depends on the t0 points alone: it is built on the second
+    // core while the first runs the sequential auction before the first search.
+    let build_tree = || opts.certify.then(|| certificate::WeightedTree::new(x0));
+    let (mut lap, mut bids, tree) = if let Some(cut) = cut {
         // The slabs stop where the certified path pauses (the global auction repairs
         // the seams at that ε, then carries on as below).
         let eps_slabs = (eps0 / AUCTION_REFINE).max(1);
@@ -470,14 +490,17 @@ fn sparse(
             cut.count(),
             lap.free_rows()
         );
-        let seam_bids = lap.auction(&graph, eps_slabs, AUCTION_THETA, eps_pause(eps0), budget);
+        let (seam_bids, tree) = rayon::join(
+            || lap.auction(&graph, eps_slabs, AUCTION_THETA, eps_pause(eps0), budget),
+            build_tree,
+        );
         trace!(
             t,
             "seams: auction {eps_slabs} -> {}: {seam_bids} bids, {} rows free",
             eps_pause(eps0),
             lap.free_rows()
         );
-        (lap, slab_bids + seam_bids)
+        (lap, slab_bids + seam_bids, tree)
     } else {
         let mut lap = sparse_lap::Lap::new(n);
         lap.set_potentials(&v_axial);
@@ -487,14 +510,17 @@ fn sparse(
             "axial potentials + row reduction: {} rows free",
             lap.free_rows()
         );
-        let bids = lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
+        let (bids, tree) = rayon::join(
+            || lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget),
+            build_tree,
+        );
         trace!(
             t,
             "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
             eps_pause(eps0),
             lap.free_rows()
         );
-        (lap, bids)
+        (lap, bids, tree)
     };
     // An auction that stops on its budget may be bidding on a graph without a perfect
     // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
@@ -507,8 +533,8 @@ fn sparse(
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
-            (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
-            graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
+            let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
+            graph = candidates::Graph::from_knn(k0, kc, kw);
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
             lap.greedy_init(&graph);
@@ -519,7 +545,7 @@ fn sparse(
             trace!(t, "Hopcroft-Karp: the graph has a perfect matching");
         }
     }
-    let mut wtree: Option<certificate::WeightedTree> = None;
+    let mut wtree = tree;
     let mut added = 0usize;
     let mut examined = 0u64;
     let mut paused = eps_pause(eps0) > 1;
@@ -550,10 +576,7 @@ fn sparse(
         if check.violations.is_empty() {
             break;
         }
-        let before = graph.edges();
-        extras = merge(extras, check.violations);
-        graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
-        added += graph.edges() - before;
+        added += graph.insert(&check.violations, x0, x1, scale);
         // The auction frees the rows undercut by more than ε by a new edge.
         let resume = (eps0 / AUCTION_RESUME).clamp(1, eps_pause(eps0));
         bids += lap.auction(&graph, resume, AUCTION_THETA, 1, budget);
@@ -592,8 +615,7 @@ fn sparse(
                 }
                 let more = feasibility::exit_edges(&graph, x0, x1, &deficient);
                 grown += more.len();
-                extras = merge(extras, more);
-                graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
+                graph.insert(&more, x0, x1, scale);
             }
             // A failed search proves there is no perfect matching (the symmetric
             // difference with one would hold an augmenting path), so growth happened.
@@ -631,8 +653,7 @@ fn sparse(
         // The violations come sorted by row.
         let mut touched: Vec<usize> = check.violations.iter().map(|e| e.0 as usize).collect();
         touched.dedup();
-        extras = merge(extras, check.violations);
-        graph.rebuild(k0, &kc, &kw, &extras, x0, x1, scale);
+        graph.insert(&check.violations, x0, x1, scale);
         let freed = lap.restore_invariant_on(&graph, touched);
         trace!(t, "round {rounds}: {freed} rows freed");
     };
@@ -665,32 +686,6 @@ fn sparse(
     (pairing, slab_count)
 }
 
-/// Union of two edge lists sorted by (row, column), without repeats. Both are sorted
-/// already (a certificate pass returns its pairs in order, and so does the growth
-/// step), so one linear merge does: sorting the union again cost 6–12 ms per repair
-/// round on the long kiln's 300 000 extra edges.
-fn merge(a: Vec<(u32, u32)>, mut b: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
-    if !b.is_sorted() {
-        b.sort_unstable();
-    }
-    debug_assert!(a.is_sorted());
-    let mut out = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() || j < b.len() {
-        let e = if j == b.len() || (i < a.len() && a[i] <= b[j]) {
-            i += 1;
-            a[i - 1]
-        } else {
-            j += 1;
-            b[j - 1]
-        };
-        if out.last() != Some(&e) {
-            out.push(e);
-        }
-    }
-    out
-}
-
 /// The tests' random beds: a xorshift64 stream of uniform numbers in [0, 1) from a fixed
 /// seed, so that every run builds the same bed.
 #[cfg(test)]
@@ -701,29 +696,5 @@ fn test_uniform(seed: u64) -> impl FnMut() -> f64 {
         s ^= s >> 7;
         s ^= s << 17;
         (s >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The linear merge is the sorted union without repeats, also when the second list
-    /// is unsorted or repeats itself.
-    #[test]
-    fn merge_is_the_sorted_union() {
-        let a = vec![(0, 3), (1, 1), (1, 5), (4, 0)];
-        for b in [
-            vec![(0, 2), (1, 5), (2, 2), (4, 0), (4, 9)],
-            vec![(4, 9), (0, 2), (2, 2), (2, 2), (1, 5)],
-            vec![],
-        ] {
-            let mut want = a.clone();
-            want.extend(b.iter().copied());
-            want.sort_unstable();
-            want.dedup();
-            assert_eq!(merge(a.clone(), b), want);
-        }
-        assert_eq!(merge(Vec::new(), vec![(3, 1), (3, 1)]), vec![(3, 1)]);
     }
 }

@@ -222,7 +222,7 @@ fn slab_graph(
         let d = (r - lo) as u32;
         if !g.cols[start..].contains(&d) {
             g.cols.push(d);
-            g.costs.push(scale.cost(&x1[p], &x0[s0[r] as usize]));
+            g.costs.push(scale.edge_cost(&x1[p], &x0[s0[r] as usize]));
         }
         g.offsets.push(g.cols.len());
     }

@@ -12,16 +12,18 @@
 //! `v` starts at 0 and augmentations only ever lower it, so `max v <= 0`: the
 //! certificate uses that to keep its search radii small.
 
+use rayon::prelude::*;
+
 use super::candidates::Graph;
 
 /// Marks a free row or column.
 pub(crate) const NONE: u32 = u32::MAX;
 
-/// The auction stops once a potential falls below this. Costs are at most 2⁴⁰ and
-/// `n · 2⁴⁰ <= 2⁶⁰` (checked up front), the scale of the potentials of a graph with a
+/// The auction stops once a potential falls below this. Costs are at most `C = 2³² − 1`
+/// and `n · C <= 2⁶⁰` (checked up front), the scale of the potentials of a graph with a
 /// perfect matching; on one without, bids inside a Hall-violating set would lower
 /// them without end. Stopping here keeps the later potentials (the exact solver lowers
-/// them by at most another `n · 2⁴⁰`), distances and reduced costs below 2⁶², far from
+/// them by at most another `n · C`), distances and reduced costs below 2⁶², far from
 /// `i64` overflow.
 const V_FLOOR: i64 = -(1 << 60);
 
@@ -158,6 +160,7 @@ impl Lap {
             let (cols, costs) = g.row(p);
             let mut best: Option<(i64, u32, i64)> = None;
             for (&q, &c) in cols.iter().zip(costs) {
+                let c = i64::from(c);
                 let key = (c - self.cols[q as usize].v, q, c);
                 if best.is_none_or(|b| (key.0, key.1) < (b.0, b.1)) {
                     best = Some(key);
@@ -245,7 +248,7 @@ impl Lap {
             if cols
                 .iter()
                 .zip(costs)
-                .any(|(&q, &c)| c - self.cols[q as usize].v < u)
+                .any(|(&q, &c)| i64::from(c) - self.cols[q as usize].v < u)
             {
                 self.col_of_row[p] = NONE;
                 self.cols[q0 as usize].row = NONE;
@@ -292,6 +295,7 @@ impl Lap {
         self.scanned.clear();
         let (cols, costs) = g.row(i0);
         for (&q, &c) in cols.iter().zip(costs) {
+            let c = i64::from(c);
             let col = &mut self.cols[q as usize];
             let d = c - col.v;
             debug_assert!(d >= 0);
@@ -325,6 +329,7 @@ impl Lap {
             let ur = self.mcost[ri] - col.v;
             let (cols, costs) = g.row(ri);
             for (&k, &c) in cols.iter().zip(costs) {
+                let c = i64::from(c);
                 let col = &mut self.cols[k as usize];
                 if col.done == ep {
                     continue;
@@ -380,6 +385,7 @@ impl Lap {
             let u = self.u(p);
             let (cols, costs) = g.row(p);
             for (&q, &c) in cols.iter().zip(costs) {
+                let c = i64::from(c);
                 if c - u - self.cols[q as usize].v < 0 {
                     return Err(format!("negative reduced cost on ({p}, {q})"));
                 }
@@ -408,22 +414,28 @@ fn auction_phases(
     let mut bids = 0u64;
     let mut stack: Vec<u32> = Vec::new();
     loop {
-        // Free the rows that violate ε-CS (a new, smaller ε, or edges added since).
-        for p in 0..n {
-            let q0 = col_of_row[p];
-            if q0 == NONE {
-                continue;
-            }
-            let w0 = mcost[p] - v[q0 as usize];
-            let (cols, costs) = g.row(p);
-            if cols
-                .iter()
-                .zip(costs)
-                .any(|(&q, &c)| c - v[q as usize] + eps < w0)
-            {
-                col_of_row[p] = NONE;
-                owner[q0 as usize] = NONE;
-            }
+        // Free the rows that violate ε-CS (a new, smaller ε, or edges added since). The
+        // test reads every edge of the graph and nothing it changes, so it runs on all
+        // threads (the same rows, in the same order, whatever their number).
+        let violating: Vec<u32> = (0..n)
+            .into_par_iter()
+            .with_min_len(1024)
+            .filter(|&p| {
+                let q0 = col_of_row[p];
+                if q0 == NONE {
+                    return false;
+                }
+                let w0 = mcost[p] - v[q0 as usize];
+                let (cols, costs) = g.row(p);
+                cols.iter()
+                    .zip(costs)
+                    .any(|(&q, &c)| i64::from(c) - v[q as usize] + eps < w0)
+            })
+            .map(|p| p as u32)
+            .collect();
+        for p in violating {
+            let q0 = std::mem::replace(&mut col_of_row[p as usize], NONE);
+            owner[q0 as usize] = NONE;
         }
         stack.clear();
         stack.extend(
@@ -440,6 +452,7 @@ fn auction_phases(
             let (mut w1, mut w2) = (i64::MAX, i64::MAX);
             let (mut j1, mut c1) = (NONE, 0);
             for (&q, &c) in cols.iter().zip(costs) {
+                let c = i64::from(c);
                 let w = c - v[q as usize];
                 if w < w1 {
                     w2 = w1;
@@ -605,8 +618,9 @@ mod tests {
     }
 
     use super::*;
+    use crate::pairing::cost::EdgeCost;
 
-    fn graph(rows: &[&[(u32, i64)]]) -> Graph {
+    fn graph(rows: &[&[(u32, EdgeCost)]]) -> Graph {
         let mut g = Graph::default();
         g.offsets.push(0);
         for r in rows {
@@ -668,7 +682,7 @@ mod tests {
                 cols.dedup();
                 for q in cols {
                     g.cols.push(q);
-                    g.costs.push(rnd(spread) as i64);
+                    g.costs.push(rnd(spread) as EdgeCost);
                 }
                 g.offsets.push(g.cols.len());
             }
