@@ -645,7 +645,7 @@ mod tests {
             for k in [1, 4, 24] {
                 let (c, w) = knn(&grid, &x0, &x1, &centres, k, &scale);
                 let g = Graph::from_knn(k, c, w);
-                let whole = crate::pairing::sparse_lap::mean_cheapest(&g);
+                let whole = crate::pairing::sparse_lap::Cheapest::of(&g).mean();
                 let every = mean_cheapest_sampled(&grid, &x0, &x1, &centres, k, 1, &scale);
                 assert_eq!(every, whole, "k {k}");
                 let sampled = mean_cheapest_sampled(&grid, &x0, &x1, &centres, k, 7, &scale);

@@ -36,6 +36,14 @@ pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     (dx * dx + dy * dy + dz * dz).sqrt()
 }
 
+/// The diagonal of the joint bounding box of the two snapshots: it bounds every pair
+/// distance. Computed per axis first, so that a huge extent shows up as infinity rather
+/// than silently wrapping (NaN if a coordinate is).
+pub(crate) fn diagonal(x0: &[[f64; 3]], x1: &[[f64; 3]]) -> f64 {
+    let (lo, hi) = super::order::bounds(x0, x1);
+    distance(&lo, &hi)
+}
+
 /// The scaling from distances to integer costs, validated against the data extent.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CostScale {
@@ -53,10 +61,7 @@ impl CostScale {
                 reason: format!("must be finite and > 0, got {unit}"),
             });
         }
-        let (lo, hi) = super::order::bounds(x0, x1);
-        // The diagonal bounds every pair distance; computed per axis first so that a
-        // huge extent shows up as infinity rather than silently wrapping.
-        let diag = distance(&lo, &hi);
+        let diag = diagonal(x0, x1);
         let units = diag / unit;
         let n = x0.len().max(1) as f64;
         if !(units.is_finite() && units <= MAX_PAIR_UNITS && units * n <= MAX_TOTAL_UNITS) {

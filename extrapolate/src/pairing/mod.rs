@@ -79,12 +79,12 @@ impl PairingOptions {
     /// coordinates leave the unit as it is; [`pair`] reports them.
     #[must_use]
     pub fn for_bed(diameter: f64, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
-        let (lo, hi) = order::bounds(x0, x1);
-        let diagonal = cost::distance(&lo, &hi);
         let opts = Self::for_diameter(diameter);
         Self {
             // f64::max ignores a NaN diagonal: the unit stays a millionth of a diameter
-            unit: opts.unit.max(diagonal / (0.999 * cost::MAX_PAIR_UNITS)),
+            unit: opts
+                .unit
+                .max(cost::diagonal(x0, x1) / (0.999 * cost::MAX_PAIR_UNITS)),
             ..opts
         }
     }
@@ -432,13 +432,14 @@ fn sparse(
     let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     trace!(t, "knn k {k0}");
     let mut graph = candidates::Graph::from_knn(k0, kc, kw);
-    let rho = sparse_lap::mean_cheapest(&graph) * scale.unit();
+    let cheapest = sparse_lap::Cheapest::of(&graph);
+    let rho = cheapest.mean() * scale.unit();
     trace!(
         t,
         "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, sampled {rho_sampled:.3e}) + knn k {k0} + graph"
     );
     let v_axial = axial.potentials(x0, rho, scale.unit());
-    let mut eps0 = sparse_lap::initial_eps(&graph);
+    let mut eps0 = cheapest.initial_eps();
     let budget = AUCTION_BIDS_PER_ROW * n as u64;
     // With the certificate, the auction pauses at ε0 / AUCTION_REFINE for the
     // certificate searches below and resumes from there.
@@ -538,7 +539,7 @@ fn sparse(
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
             lap.greedy_init(&graph);
-            eps0 = sparse_lap::initial_eps(&graph);
+            eps0 = sparse_lap::Cheapest::of(&graph).initial_eps();
             bids += lap.auction(&graph, eps0, AUCTION_THETA, eps_pause(eps0), budget);
             trace!(t, "k doubled to {k0}, auction again: {bids} bids in all");
         } else {

@@ -491,34 +491,43 @@ fn auction_phases(
     }
 }
 
-/// Mean cost of the rows' cheapest candidates (at least 0).
-pub(crate) fn mean_cheapest(g: &Graph) -> f64 {
-    let (sum, rows) = cheapest_sum(g);
-    sum as f64 / rows as f64
+/// The rows' cheapest candidate costs, summed in one pass over the graph: the solver
+/// needs their mean (the typical pair distance) and the auction's initial ε from it.
+pub(crate) struct Cheapest {
+    sum: i128,
+    /// At least 1, so that an empty graph divides safely.
+    rows: usize,
 }
 
-/// The sum over rows of each row's cheapest candidate cost, and the row count (at least
-/// 1, so that an empty graph divides safely): the one pass both the mean and ε₀ need.
-fn cheapest_sum(g: &Graph) -> (i128, usize) {
-    let sum = (0..g.rows())
-        .map(|p| g.row(p).1.iter().copied().min().unwrap_or(0) as i128)
-        .sum();
-    (sum, g.rows().max(1))
-}
+impl Cheapest {
+    pub(crate) fn of(g: &Graph) -> Self {
+        let sum = (0..g.rows())
+            .map(|p| g.row(p).1.iter().copied().min().unwrap_or(0) as i128)
+            .sum();
+        Self {
+            sum,
+            rows: g.rows().max(1),
+        }
+    }
 
-/// Initial ε of the auction: the power of two nearest to twice the mean cost of the
-/// rows' cheapest candidates (a million units, one diameter at the default unit, on a
-/// packed bed), at least 1.
-pub(crate) fn initial_eps(g: &Graph) -> i64 {
-    let (sum, rows) = cheapest_sum(g);
-    let target = (2 * sum / rows as i128).max(1) as u64;
-    let up = target.next_power_of_two();
-    let eps = if up - target > target - up / 2 {
-        up / 2
-    } else {
-        up
-    };
-    eps.max(1) as i64
+    /// Mean cost of the rows' cheapest candidates (at least 0).
+    pub(crate) fn mean(&self) -> f64 {
+        self.sum as f64 / self.rows as f64
+    }
+
+    /// Initial ε of the auction: the power of two nearest to twice the mean cost of the
+    /// rows' cheapest candidates (a million units, one diameter at the default unit, on
+    /// a packed bed), at least 1.
+    pub(crate) fn initial_eps(&self) -> i64 {
+        let target = (2 * self.sum / self.rows as i128).max(1) as u64;
+        let up = target.next_power_of_two();
+        let eps = if up - target > target - up / 2 {
+            up / 2
+        } else {
+            up
+        };
+        eps.max(1) as i64
+    }
 }
 
 /// Monotone priority queue for non-negative integer keys (radix heap): a key goes to
@@ -691,7 +700,7 @@ mod tests {
             let ok = plain.solve(&g).is_ok();
             let mut warm = Lap::new(n);
             warm.greedy_init(&g);
-            let eps0 = initial_eps(&g);
+            let eps0 = Cheapest::of(&g).initial_eps();
             warm.auction(&g, eps0, 8, 1, 50 * n as u64);
             assert!((0..n).all(|q| warm.v(q) <= 0));
             for p in 0..n {
