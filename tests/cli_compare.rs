@@ -245,6 +245,102 @@ fn a_second_dem_run_is_compared_on_its_own_particles() {
     );
 }
 
+/// An extrapolation of one recording compared with the reference of another recording of
+/// the same run: here two quarter-revolution periods recorded (t0 … t0 + ½ rev), against a
+/// half-revolution recording's reference. The snapshots are matched by time: only those at
+/// the reference's instants are compared, numbered as the reference's t_k, each over the
+/// stretch since the one before; a recording of another run is refused.
+#[test]
+fn an_extrapolation_of_another_recording_of_the_run_is_compared_at_the_shared_instants() {
+    let dir = tempfile::tempdir().unwrap();
+    let reference = record_tiny(dir.path(), "ref", 5, ["--tau-rev", "0.5"], 2);
+    let quarters = dir.path().join("quarters.mcap");
+    let case = dir.path().join("ref.toml");
+    let q_s = quarters.to_str().unwrap();
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        q_s,
+        "--tau-rev",
+        "0.25",
+        "--recorded-periods",
+        "2",
+    ]);
+    let extra = dir.path().join("quarters.extra.mcap");
+    let extra_s = extra.to_str().unwrap();
+    // t1 … t6 of the quarters (the replay starts at t1): t0 + ¼ … 1½ rev
+    tdex_ok(&["extrapolate", q_s, "--periods", "5", "-o", extra_s]);
+    // the same run: its snapshot at t0 + ½ rev is the reference's t1, bit for bit
+    let ref_snaps = RecordingReader::open(&reference)
+        .unwrap()
+        .snapshots()
+        .unwrap();
+    let q_snaps = RecordingReader::open(&quarters)
+        .unwrap()
+        .snapshots()
+        .unwrap();
+    let at = |snaps: &[tdex_format::Snapshot], k: u32| snaps.iter().find(|s| s.index == k).cloned();
+    let (r1, q2) = (at(&ref_snaps, 1).unwrap(), at(&q_snaps, 2).unwrap());
+    assert_eq!((r1.time, &r1.pos, &r1.temp), (q2.time, &q2.pos, &q2.temp));
+
+    let ref_s = reference.to_str().unwrap();
+    let v: serde_json::Value = serde_json::from_str(&tdex_ok(&[
+        "compare", ref_s, extra_s, "--cells", "20", "--json",
+    ]))
+    .unwrap();
+    let periods = v["periods"].as_array().unwrap();
+    let ks: Vec<u64> = periods.iter().map(|p| p["k"].as_u64().unwrap()).collect();
+    assert_eq!(ks, vec![2, 3], "the reference's t2 and t3: {v}");
+    for p in periods {
+        let k = p["k"].as_u64().unwrap() as u32;
+        let dem = at(&ref_snaps, k).unwrap();
+        assert!((p["t"].as_f64().unwrap() - dem.time).abs() < 0.5e-4, "{p}");
+        // the DEM side is the reference's own snapshot at t_k
+        let hot = v["dem_series"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|g| g["k"].as_u64() == Some(k as u64))
+            .unwrap()["hot"]
+            .clone();
+        assert_eq!(p["hot_mean_dem"], hot, "{p}");
+        assert!(p["eps_abs"].as_f64().unwrap() > 0.0, "{p}");
+    }
+    // the quarters in between have no reference instant: not compared, and said so
+    let unreferenced: Vec<u64> = v["unreferenced"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k.as_u64().unwrap())
+        .collect();
+    assert_eq!(unreferenced, vec![1, 3, 5], "{v}");
+    let table = tdex_ok(&["compare", ref_s, extra_s, "--cells", "20"]);
+    assert!(
+        table.contains("not compared, no DEM snapshot at their instant: t_1, t_3, t_5"),
+        "{table}"
+    );
+
+    // another seed is another run: refused, and the error says what must agree
+    let other = record_tiny(dir.path(), "other", 6, ["--tau-rev", "0.25"], 0);
+    let other_extra = dir.path().join("other.extra.mcap");
+    tdex_ok(&[
+        "extrapolate",
+        other.to_str().unwrap(),
+        "--periods",
+        "2",
+        "-o",
+        other_extra.to_str().unwrap(),
+    ]);
+    let o = run_tdex(&["compare", ref_s, other_extra.to_str().unwrap()]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("same DEM run") && err.contains("t0 must agree"),
+        "{err}"
+    );
+}
+
 /// A recording with one real DEM twin: `compare` measures the floor between the DEM and
 /// the twin at every t_k, the extrapolation's distance to both runs and the ratio, and says
 /// its verdict; the twin is stored in the recording, found without extra arguments.

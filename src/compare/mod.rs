@@ -151,8 +151,9 @@ pub enum CompareError {
     #[error(transparent)]
     Format(#[from] FormatError),
     #[error(
-        "{extrapolation} was not extrapolated from {recording} (it names {names}, and the \
-         recordings' metadata differ)"
+        "{extrapolation} was not extrapolated from {recording} nor from another recording \
+         of the same DEM run (it names {names}; the case, the particle count, the time step \
+         and t0 must agree)"
     )]
     OtherRecording {
         extrapolation: String,
@@ -266,7 +267,8 @@ pub fn compare_runs(
     let (extra_path, extra, kind, own_groups) = match second {
         Second::Extrapolation(extrapolation) => {
             let extra_path = extrapolation.path().display().to_string();
-            if extrapolation.info().recording_info != *recording.info() {
+            let own = &extrapolation.info().recording_info;
+            if own != recording.info() && !same_run(own, recording.info()) {
                 return Err(CompareError::OtherRecording {
                     extrapolation: extra_path,
                     recording: rec_path,
@@ -374,19 +376,35 @@ pub fn compare_runs(
     // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
     // a recurrence path (assigned anew when they change); a second DEM run moves, so each of
     // its snapshots is assigned anew.
+    //
+    // The second field's snapshots are matched to the DEM's by time, to half a step: the same
+    // index for an extrapolation of this recording, and for one of another recording of the
+    // same run (another period τ, more recorded periods) the reference t_k it lands on; its
+    // snapshots between two reference instants are skipped, and each compared one is measured
+    // over the stretch since the last compared one (t_{k−1} → t_k).
+    let half_step = 0.5 * recording.info().dt;
+    let dem_index_at = |time: f64| {
+        dem.iter()
+            .find(|d| (d.time - time).abs() <= half_step)
+            .map(|d| d.index)
+    };
     let mut role_cells: Option<(Vec<[f64; 3]>, Vec<u32>)> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
-    let mut previous: Option<Snapshot> = None;
+    let mut previous: Option<(u32, Snapshot)> = None;
     for after in extra {
-        // the snapshot before moves out, this one stays as the next one's before: no copy
-        let Some(before) = previous.replace(after?) else {
+        let after = after?;
+        let Some(k) = dem_index_at(after.time) else {
+            unreferenced.push(after.index);
             continue;
         };
-        let (before, after) = (&before, previous.as_ref().expect("set just above"));
-        let k = after.index;
-        let (Some(dem_before), Some(dem_after)) = (dem_at(before.index), dem_at(k)) else {
-            unreferenced.push(k);
+        // the snapshot before moves out, this one stays as the next one's before: no copy
+        let Some((k_before, before)) = previous.replace((k, after)) else {
+            continue;
+        };
+        let (before, after) = (&before, &previous.as_ref().expect("set just above").1);
+        let (Some(dem_before), Some(dem_after)) = (dem_at(k_before), dem_at(k)) else {
+            unreferenced.push(after.index);
             continue;
         };
         let dem_means = cells_v.means(&dem_after.pos, &dem_after.temp);
@@ -438,7 +456,7 @@ pub fn compare_runs(
                 let twin_after = o.iter().find(|s| s.index == k)?;
                 let twin_before = o
                     .iter()
-                    .find(|s| s.index == before.index)
+                    .find(|s| s.index == k_before)
                     .map_or(&dem_before.temp, |s| &s.temp);
                 metrics::energy_error(
                     &dem_before.temp,
@@ -519,6 +537,18 @@ pub fn compare_runs(
     })
 }
 
+/// Whether two recordings were made of the same DEM run: the same resolved case (seed
+/// included), particle count, time step and `t0`. The engine does not depend on how a run is
+/// recorded (`τ`, `n`, `Δt_c^max`, the periods recorded or referenced), so their snapshots
+/// at the same instant are the same state, and an extrapolation of one can be compared with
+/// the other's reference at the instants they share.
+fn same_run(a: &tdex_format::RecordingInfo, b: &tdex_format::RecordingInfo) -> bool {
+    a.case_resolved == b.case_resolved
+        && a.particles == b.particles
+        && a.dt == b.dt
+        && a.step_t0 == b.step_t0
+}
+
 /// A second DEM run is compared only with the same particle count and at the same instants:
 /// each of its snapshots that the recording also has must be within half a step of it.
 fn check_same_instants(
@@ -552,6 +582,27 @@ fn check_same_instants(
         }
     }
     Ok(())
+}
+
+/// Snapshot indices in words, runs of three or more consecutive ones shortened:
+/// `t_1, t_3, t_5 … t_9`.
+pub fn span_of(ks: &[u32]) -> String {
+    let mut words = Vec::new();
+    let mut rest = ks;
+    while let [first, ..] = rest {
+        let run = 1 + rest.windows(2).take_while(|w| w[1] == w[0] + 1).count();
+        words.push(if run >= 3 {
+            format!("t_{first} … t_{}", rest[run - 1])
+        } else {
+            rest[..run]
+                .iter()
+                .map(|k| format!("t_{k}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        });
+        rest = &rest[run..];
+    }
+    words.join(", ")
 }
 
 fn opt(x: Option<f64>, scale: f64, digits: usize) -> String {
@@ -643,7 +694,10 @@ pub fn table(c: &Comparison) -> String {
         s += "\n";
     }
     if !c.unreferenced.is_empty() {
-        s += &format!("no DEM reference for t_k, k = {:?}\n", c.unreferenced);
+        s += &format!(
+            "not compared, no DEM snapshot at their instant: {}\n",
+            span_of(&c.unreferenced)
+        );
     }
     s += &format!("verdict: {}\n", c.verdict.text);
     s
@@ -677,4 +731,21 @@ pub fn csv(c: &Comparison) -> String {
         );
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::span_of;
+
+    #[test]
+    fn runs_of_three_or_more_indices_are_shortened() {
+        assert_eq!(span_of(&[3, 4, 5]), "t_3 … t_5");
+        assert_eq!(span_of(&[3, 5]), "t_3, t_5");
+        assert_eq!(span_of(&[3, 4]), "t_3, t_4");
+        assert_eq!(
+            span_of(&[1, 3, 5, 7, 8, 9, 10]),
+            "t_1, t_3, t_5, t_7 … t_10"
+        );
+        assert_eq!(span_of(&[]), "");
+    }
 }

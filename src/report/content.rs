@@ -727,7 +727,7 @@ fn errors_section(d: &mut Document, c: &Comparison) {
         d.push(para(vec![text(format!(
             "No DEM reference for {} (the recording was made with a smaller --reference): \
              not compared.",
-            span_of(&c.unreferenced)
+            crate::compare::span_of(&c.unreferenced)
         ))]));
     }
     figure(
@@ -738,20 +738,6 @@ fn errors_section(d: &mut Document, c: &Comparison) {
         ERRORS_SVG,
         "Absolute, relative and energy-transfer errors per extrapolation step, and the contrast",
     );
-}
-
-/// `t_2 … t_9` for consecutive indices, else the list.
-fn span_of(ks: &[u32]) -> String {
-    match ks {
-        [first, .., last] if ks.windows(2).all(|w| w[1] == w[0] + 1) && ks.len() > 2 => {
-            format!("t_{first} … t_{last}")
-        }
-        _ => ks
-            .iter()
-            .map(|k| format!("t_{k}"))
-            .collect::<Vec<_>>()
-            .join(", "),
-    }
 }
 
 /// A paragraph `caption` linking `file`, then the image itself.
@@ -971,7 +957,5 @@ mod tests {
         assert_eq!(temp_decimals(148.0), 1);
         assert_eq!(temp_decimals(0.05), 4);
         assert_eq!(kelvin(169.6123, 1), "169.6 K");
-        assert_eq!(span_of(&[3, 4, 5]), "t_3 … t_5");
-        assert_eq!(span_of(&[3, 5]), "t_3, t_5");
     }
 }
