@@ -71,6 +71,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         recorded_periods: None,
         path_seed: None,
         jump_targets: None,
+        symmetry: tdex_format::extrapolation::Symmetry::None,
     };
     let outcome = crate::with_workers(plan.threads, || {
         Ok(extrapolate::extrapolate_recording(

@@ -10,7 +10,7 @@ use extrapolate::{
     ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice,
 };
 use serde::Serialize;
-use tdex_format::extrapolation::{RecurrencePath, Roles};
+use tdex_format::extrapolation::{RecurrencePath, Roles, Symmetry};
 use tdex_format::ExtrapolationCosts;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
@@ -27,6 +27,8 @@ struct ExtrapolationReport {
     /// `pairing` (one recorded period) or `path` (several).
     #[serde(flatten)]
     roles: RolesReport,
+    /// `none` or `axial_mirror`.
+    symmetry: Symmetry,
     costs: ExtrapolationCosts,
     total_heat_t1: f64,
     total_heat_end: f64,
@@ -51,6 +53,7 @@ impl ExtrapolationReport {
                     path,
                 }),
             },
+            symmetry: outcome.symmetry,
             costs: outcome.costs,
             total_heat_t1: outcome.total_heat_t1,
             total_heat_end: outcome.total_heat_end,
@@ -97,12 +100,43 @@ pub fn path_words(path: &RecurrencePath) -> String {
     )
 }
 
+/// What the symmetry did to the jumps, in plain words (`None` without one).
+pub fn symmetry_words(symmetry: Symmetry) -> Option<&'static str> {
+    match symmetry {
+        Symmetry::None => None,
+        Symmetry::AxialMirror => Some(
+            "axial mirror: every jump entered the mirror image (y → −y) of its start, so the \
+             periods replayed alternate between the recording and its mirror image",
+        ),
+    }
+}
+
+/// The start a pairing joins the end to: `t<start>`, or its mirror image.
+pub fn start_words(start: u32, symmetry: Symmetry) -> String {
+    match symmetry {
+        Symmetry::None => format!("t{start}"),
+        Symmetry::AxialMirror => format!("the mirror image of t{start}"),
+    }
+}
+
+/// What the line of the one pairing says first: nothing for `t1` to `t0` (as it always
+/// read), which images it joins under a symmetry.
+pub fn pairing_prefix(symmetry: Symmetry) -> String {
+    match symmetry {
+        Symmetry::None => String::new(),
+        Symmetry::AxialMirror => format!("t1 to {}: ", start_words(0, symmetry)),
+    }
+}
+
 /// A pairing of a path in plain words: its snapshots and mean distance.
-pub fn path_pairing_words(p: &tdex_format::extrapolation::PathPairing) -> String {
+pub fn path_pairing_words(
+    p: &tdex_format::extrapolation::PathPairing,
+    symmetry: Symmetry,
+) -> String {
     format!(
-        "t{} to t{}: mean distance {} diameters, {}",
+        "t{} to {}: mean distance {} diameters, {}",
         p.end,
-        p.start,
+        start_words(p.start, symmetry),
         crate::fmt::sig(p.summary.mean_distance_diameters, 4),
         if p.summary.certified {
             "certified"
@@ -128,6 +162,7 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         recorded_periods: plan.recorded_periods,
         path_seed: plan.seed,
         jump_targets: plan.jump_to.clone(),
+        symmetry: plan.symmetry,
     };
     let outcome = crate::with_workers(plan.threads, || {
         extrapolate::extrapolate_recording(&request, tell).map_err(advice)
@@ -308,7 +343,8 @@ pub fn print(
         let reused = if c.pairing_reused { ", reused" } else { "" };
         match &report.roles {
             RolesReport::Pairing(pairing) => println!(
-                "pairing       mean distance {} diameters, {} ({:.2} s{reused})",
+                "pairing       {}mean distance {} diameters, {} ({:.2} s{reused})",
+                pairing_prefix(report.symmetry),
                 crate::fmt::sig(pairing.mean_distance_diameters, 4),
                 if pairing.certified {
                     "certified"
@@ -323,7 +359,7 @@ pub fn print(
                     println!("pairings      none: the path stayed inside the recording");
                 }
                 for p in &path.pairings {
-                    println!("pairing       {}", path_pairing_words(p));
+                    println!("pairing       {}", path_pairing_words(p, report.symmetry));
                 }
                 if !path.pairings.is_empty() {
                     println!(
@@ -333,6 +369,9 @@ pub fn print(
                     );
                 }
             }
+        }
+        if let Some(words) = symmetry_words(report.symmetry) {
+            println!("symmetry      {words}");
         }
         println!(
             "replay        {:.3} s per period, {:.3e} rows/s (table read {:.2} s, {})",

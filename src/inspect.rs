@@ -209,6 +209,8 @@ struct ExtrapolationInspection {
     /// `tdex pair --json`) for one recorded period, `path` for several.
     #[serde(flatten)]
     roles: tdex_format::extrapolation::Roles,
+    /// `none` or `axial_mirror`: the drum's symmetry the jumps used.
+    symmetry: tdex_format::extrapolation::Symmetry,
     /// Σ m c T (J) over the particles at the first snapshot (`t1`) and at the last, with
     /// `m c = density · heat_capacity · (4/3)π r³` of the recording's material.
     total_heat_start: f64,
@@ -560,6 +562,7 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         periods: info.periods,
         // the pairing's keys in the order the file holds them (sorted)
         roles: info.roles.clone(),
+        symmetry: info.symmetry,
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,
@@ -601,7 +604,8 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
     );
     match &s.roles {
         Roles::Pairing(p) => println!(
-            "pairing       {} particles, mean distance {} diameters (total {}), k = {}, {} solve round(s), {}",
+            "pairing       {}{} particles, mean distance {} diameters (total {}), k = {}, {} solve round(s), {}",
+            crate::extrapolation::pairing_prefix(s.symmetry),
             p.particles,
             fmt::num(p.mean_distance_diameters),
             fmt::num(p.total_distance_diameters),
@@ -618,10 +622,13 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
             for p in &path.pairings {
                 println!(
                     "pairing       {}",
-                    crate::extrapolation::path_pairing_words(p)
+                    crate::extrapolation::path_pairing_words(p, s.symmetry)
                 );
             }
         }
+    }
+    if let Some(words) = crate::extrapolation::symmetry_words(s.symmetry) {
+        println!("symmetry      {words}");
     }
     println!(
         "heat          Σ m c T {:.6e} J at the start, {:.6e} J at the end (relative change {:.2e})",

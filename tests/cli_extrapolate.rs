@@ -1,4 +1,4 @@
-//! `tdex extrapolate`: the memory stated before the work (`--max-memory`), a table that does not fit streamed from the file with the same bytes out as in memory, a limit below the per-particle state refused, and `--reproducible` pairings and extrapolations that are the same bytes whatever the thread count.
+//! `tdex extrapolate`: the memory stated before the work (`--max-memory`), a table that does not fit streamed from the file with the same bytes out as in memory, a limit below the per-particle state refused, `--reproducible` pairings and extrapolations that are the same bytes whatever the thread count, and `--mirror` stated, stored apart and reproducible.
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;
@@ -9,25 +9,35 @@ use std::process::Output;
 /// steps: about 250 000 rows, four batches of 65 536 on the wire, so a streamed replay
 /// crosses batch boundaries (inside synchronous groups too).
 fn many_rows(dir: &Path) -> PathBuf {
-    let case = dir.join("tiny.toml");
     let heated = TINY_CASE.replace(
         "rotation_period = 2.0",
         "rotation_period = 2.0\nwall_temperature = 350.0",
     );
-    std::fs::write(&case, heated).unwrap();
+    record(
+        dir,
+        &heated,
+        &["--tau", "0.1", "--n", "1", "--dtc-max", "2"],
+    )
+}
+
+/// The tiny drum recorded with `--reproducible` into `dir/run.mcap`.
+fn tiny_reproducible(dir: &Path) -> PathBuf {
+    record(dir, TINY_CASE, &["--reproducible"])
+}
+
+/// The case `case` (TOML text) recorded with `flags` into `dir/run.mcap`.
+fn record(dir: &Path, case: &str, flags: &[&str]) -> PathBuf {
+    let case_file = dir.join("tiny.toml");
+    std::fs::write(&case_file, case).unwrap();
     let run = dir.join("run.mcap");
-    tdex_ok(&[
+    let mut args = vec![
         "record",
-        case.to_str().unwrap(),
+        case_file.to_str().unwrap(),
         "-o",
         run.to_str().unwrap(),
-        "--tau",
-        "0.1",
-        "--n",
-        "1",
-        "--dtc-max",
-        "2",
-    ]);
+    ];
+    args.extend_from_slice(flags);
+    tdex_ok(&args);
     run
 }
 
@@ -168,17 +178,8 @@ fn a_limit_below_the_per_particle_state_is_refused_before_any_work() {
 #[test]
 fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_count() {
     let dir = tempfile::tempdir().unwrap();
-    let case = dir.path().join("tiny.toml");
-    std::fs::write(&case, TINY_CASE).unwrap();
-    let run = dir.path().join("run.mcap");
+    let run = tiny_reproducible(dir.path());
     let run_s = run.to_str().unwrap();
-    tdex_ok(&[
-        "record",
-        case.to_str().unwrap(),
-        "-o",
-        run_s,
-        "--reproducible",
-    ]);
     let sidecar = dir.path().join("run.mcap.pairing.json");
     let mut pairings = Vec::new();
     for threads in ["1", "2"] {
@@ -226,4 +227,55 @@ fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_cou
     let timed = dir.path().join("timed.mcap");
     json_of(&extrapolate(&run, &timed, &[]));
     assert!(!up_to_costs(&timed).is_empty());
+}
+
+#[test]
+fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = tiny_reproducible(dir.path());
+    let mut files = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("m{threads}.mcap"));
+        let o = extrapolate(
+            &run,
+            &out,
+            &["--mirror", "--threads", threads, "--reproducible"],
+        );
+        let report = json_of(&o);
+        assert_eq!(report["symmetry"], "axial_mirror");
+        assert_eq!(report["pairing"]["certified"], true);
+        files.push(std::fs::read(&out).unwrap());
+        std::fs::remove_file(dir.path().join("run.mcap.pairing.t1-mirror-t0.json")).unwrap();
+    }
+    assert!(files[0] == files[1], "the mirror depends on the threads");
+    // the mirror's pairing has a sidecar of its own; the plain pairing's is not touched
+    let m = dir.path().join("m.mcap");
+    let text = tdex_ok(&[
+        "extrapolate",
+        run.to_str().unwrap(),
+        "--periods",
+        "3",
+        "-o",
+        m.to_str().unwrap(),
+        "--mirror",
+    ]);
+    assert!(
+        text.contains("pairing       t1 to the mirror image of t0: mean distance")
+            && text.contains("symmetry      axial mirror"),
+        "{text}"
+    );
+    assert!(dir
+        .path()
+        .join("run.mcap.pairing.t1-mirror-t0.json")
+        .exists());
+    assert!(!dir.path().join("run.mcap.pairing.json").exists());
+    let inspected = tdex_ok(&["inspect", m.to_str().unwrap()]);
+    assert!(
+        inspected.contains("t1 to the mirror image of t0") && inspected.contains("axial mirror"),
+        "{inspected}"
+    );
+    // without the flag: no symmetry, and the plain pairing
+    let plain = dir.path().join("p.mcap");
+    assert_eq!(json_of(&extrapolate(&run, &plain, &[]))["symmetry"], "none");
+    assert!(dir.path().join("run.mcap.pairing.json").exists());
 }

@@ -8,6 +8,7 @@ use crate::sidecar::{self, PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
 use std::hash::Hasher;
 use std::path::PathBuf;
+use tdex_format::extrapolation::Symmetry;
 use tdex_format::{RecordingReader, Snapshot};
 
 /// The recording's snapshot `t_index`.
@@ -66,10 +67,38 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, Extrapolat
 /// matches them (a missing, unreadable or malformed sidecar is computed again). The
 /// snapshots' indices name the sidecar ([`sidecar::path_between`]).
 pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<StoredPairing> {
+    load_image(reader, t0, t1, Symmetry::None)
+}
+
+/// The image of snapshot `start` a jump under `symmetry` enters: the snapshot itself, or
+/// its mirror image (`y → −y` on positions and velocities), with its index.
+pub fn start_image(start: &Snapshot, symmetry: Symmetry) -> Snapshot {
+    let mut image = start.clone();
+    symmetry.image_of(true, &mut image.pos, &mut image.vel);
+    image
+}
+
+/// Where the pairing of snapshot `end` to (the image under `symmetry` of) snapshot `start`
+/// is stored beside the recording.
+fn sidecar_path(reader: &RecordingReader, end: u32, start: u32, symmetry: Symmetry) -> PathBuf {
+    match symmetry {
+        Symmetry::None => sidecar::path_between(reader.path(), end, start),
+        Symmetry::AxialMirror => sidecar::path_to_mirror_image(reader.path(), end, start),
+    }
+}
+
+/// [`load`] of the pairing of `t1` (end) to `start`, the image under `symmetry` of a
+/// recorded start ([`start_image`]): its sidecar is named by the symmetry as well.
+pub fn load_image(
+    reader: &RecordingReader,
+    start: &Snapshot,
+    t1: &Snapshot,
+    symmetry: Symmetry,
+) -> Option<StoredPairing> {
     let n = reader.info().particles as usize;
-    let path = sidecar::path_between(reader.path(), t1.index, t0.index);
+    let path = sidecar_path(reader, t1.index, start.index, symmetry);
     let stored = sidecar::read(&path, n).ok()??;
-    (stored.snapshots_fingerprint == fingerprint(t0, t1)).then_some(stored)
+    (stored.snapshots_fingerprint == fingerprint(start, t1)).then_some(stored)
 }
 
 /// Writes the pairing of snapshot `end` to snapshot `start` beside the recording
@@ -80,7 +109,18 @@ pub fn store(
     start: u32,
     stored: &StoredPairing,
 ) -> Result<PathBuf, ExtrapolateError> {
-    let path = sidecar::path_between(reader.path(), end, start);
+    store_image(reader, end, start, Symmetry::None, stored)
+}
+
+/// [`store`] of the pairing of snapshot `end` to the image under `symmetry` of `start`.
+pub fn store_image(
+    reader: &RecordingReader,
+    end: u32,
+    start: u32,
+    symmetry: Symmetry,
+    stored: &StoredPairing,
+) -> Result<PathBuf, ExtrapolateError> {
+    let path = sidecar_path(reader, end, start, symmetry);
     Ok(tdex_format::output::write_atomically(
         &path,
         &serde_json::to_vec(stored)?,

@@ -12,7 +12,7 @@ use crate::sidecar::{PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
 use std::path::PathBuf;
 use std::time::Instant;
-use tdex_format::extrapolation::{PathPairing, RecurrencePath, Roles};
+use tdex_format::extrapolation::{PathPairing, RecurrencePath, Roles, Symmetry};
 use tdex_format::{
     ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingInfo, RecordingReader,
     Snapshot, FORMAT_VERSION,
@@ -43,6 +43,9 @@ pub struct ExtrapolationRequest {
     /// `None`: every one of them. A user restricts them to the starts whose pairing with
     /// the recording's end is short (`tdex pair` prints each one's distance).
     pub jump_targets: Option<Vec<u32>>,
+    /// The drum's symmetry the jumps use: [`Symmetry::AxialMirror`] enters the mirror image
+    /// of each start, alternating the recording and its image at every jump.
+    pub symmetry: Symmetry,
 }
 
 /// Where the replay keeps the collision table.
@@ -80,6 +83,7 @@ pub struct ExtrapolationOutcome {
     /// The pairing used (one recorded period) or the path followed, with the pairings as
     /// computed (with their times) or as stored.
     pub roles: Roles,
+    pub symmetry: Symmetry,
     pub costs: ExtrapolationCosts,
     /// `Σ C T` at `t1` and after the last period (J).
     pub total_heat_t1: f64,
@@ -113,6 +117,11 @@ pub fn extrapolate_recording(
             recorded: info.recorded_periods,
         });
     }
+    if request.symmetry == Symmetry::AxialMirror && !is_tdex_drum(&info) {
+        return Err(ExtrapolateError::NoMirrorImage {
+            recording: request.recording.clone(),
+        });
+    }
     let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
     let targets = match &request.jump_targets {
         Some(targets) => {
@@ -140,6 +149,7 @@ pub fn extrapolate_recording(
     } else {
         path::starts(&steps)
     };
+    let mirrored = path::mirrored(&steps, request.symmetry);
     let mut replayed = vec![used == 1; used as usize];
     for s in &steps {
         replayed[s.period() as usize - 1] = true;
@@ -150,9 +160,14 @@ pub fn extrapolate_recording(
         .collect::<Result<Vec<Snapshot>, _>>()?;
     let bodies = Bodies::of(&info, &snaps[0]);
     let end = &snaps[used as usize];
+    // what each jump enters: the start itself, or its mirror image
+    let start_image = |m: u32| cache::start_image(&snaps[m as usize - 1], request.symmetry);
     let mut stored: Vec<(u32, Option<StoredPairing>)> = starts
         .iter()
-        .map(|&m| (m, cache::load(&reader, &snaps[m as usize - 1], end)))
+        .map(|&m| {
+            let image = start_image(m);
+            (m, cache::load_image(&reader, &image, end, request.symmetry))
+        })
         .collect();
 
     // the memory it will need, stated and held against the limit before the pairing and
@@ -194,14 +209,16 @@ pub fn extrapolate_recording(
             None => {
                 reused = false;
                 let started = Instant::now();
-                let (start, end) = (&snaps[period as usize - 1], &snaps[used as usize]);
-                let mut stored = cache::compute(start, end)?;
+                let (start, end) = (start_image(period), &snaps[used as usize]);
+                let mut stored = cache::compute(&start, end)?;
                 if request.reproducible {
                     stored.summary = stored.summary.reproducible();
                 }
                 // the stored pairing only saves time next run: a recording on a full or
                 // read-only disk is still extrapolated
-                if let Err(e) = cache::store(&reader, end.index, start.index, &stored) {
+                if let Err(e) =
+                    cache::store_image(&reader, end.index, start.index, request.symmetry, &stored)
+                {
                     notice(Notice::PairingNotStored(&e));
                 }
                 seconds_pairing += started.elapsed().as_secs_f64();
@@ -286,6 +303,7 @@ pub fn extrapolate_recording(
         scheme: request.scheme,
         periods: request.periods,
         roles: path_of(&summary_of),
+        symmetry: request.symmetry,
     };
     let mut writer = ExtrapolationWriter::create(&request.output, &out_info)?;
     writer.write_snapshot(&snaps[1])?;
@@ -300,16 +318,16 @@ pub fn extrapolate_recording(
     // the output snapshot: t_p's positions and velocities (radii are per particle, the same
     // at every t_p), the extrapolated temperatures, and as `id` the particle that plays each
     // role (it moves with its heat, at the jumps only)
-    let mut out = if used == 1 {
+    let mut out = if used == 1 && request.symmetry.is_none() {
         snaps.pop().expect("t0 and t1")
     } else {
         snaps[1].clone()
     };
-    // the recorded period whose end the output's positions are
-    let mut positions_of = 1;
+    // the recorded period whose end the output's positions are, and in which image
+    let mut positions_of = (1, false);
     let mut next_id = Vec::with_capacity(out.id.len());
     let t = Instant::now();
-    for (k, step) in (1..=request.periods).zip(&steps) {
+    for ((k, step), &mirrored) in (1..=request.periods).zip(&steps).zip(&mirrored) {
         let p = step.period();
         if let Step::Jump { period } = *step {
             let g = pairing_of(period);
@@ -343,11 +361,14 @@ pub fn extrapolate_recording(
             }
         }
         scratch.flush(&mut temps);
-        if p != positions_of {
+        if (p, mirrored) != positions_of {
             let end = &snaps[p as usize];
             out.pos.copy_from_slice(&end.pos);
             out.vel.copy_from_slice(&end.vel);
-            positions_of = p;
+            request
+                .symmetry
+                .image_of(mirrored, &mut out.pos, &mut out.vel);
+            positions_of = (p, mirrored);
         }
         out.index = k + 1;
         out.time = info.snapshot_time(k + 1);
@@ -373,6 +394,7 @@ pub fn extrapolate_recording(
         memory,
         limit,
         roles: path_of(&|s: &StoredPairing| s.summary.clone()),
+        symmetry: request.symmetry,
         costs,
         total_heat_t1: heat_t1,
         total_heat_end: temps.total_heat(&bodies),
@@ -386,6 +408,16 @@ fn case_seed(info: &RecordingInfo) -> u64 {
         .get("seed")
         .and_then(serde_json::Value::as_u64)
         .unwrap_or(0)
+}
+
+/// Whether the recording is of a tdex drum, whose mid-plane `y = 0` is a mirror plane
+/// ([`Symmetry`]): its case (recorded, or the case an import was made with) has a `[drum]`.
+/// A future drum feature that breaks the mirror (an inclined axis, a feed at one end, a
+/// mantle heated along part of its length) must be refused here.
+fn is_tdex_drum(info: &RecordingInfo) -> bool {
+    info.case_resolved
+        .get("drum")
+        .is_some_and(serde_json::Value::is_object)
 }
 
 /// Rows of recorded period `period` (1-based): the whole table for a recording of one

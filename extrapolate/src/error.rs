@@ -45,6 +45,13 @@ pub enum ExtrapolateError {
         target: u32,
         used: u32,
     },
+    /// The axial mirror asked of a recording whose geometry is not known to be symmetric.
+    #[error(
+        "{}: its case has no [drum], so its mid-plane y = 0 is not known to be a mirror \
+         plane (the axial mirror needs a tdex drum: axis y, end caps at y = ±L/2)",
+        recording.display()
+    )]
+    NoMirrorImage { recording: PathBuf },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -62,7 +69,8 @@ impl Classify for ExtrapolateError {
             | ExtrapolateError::Replay(_)
             | ExtrapolateError::Refused { .. }
             | ExtrapolateError::RecordedPeriods { .. }
-            | ExtrapolateError::JumpTarget { .. } => Fault::Input,
+            | ExtrapolateError::JumpTarget { .. }
+            | ExtrapolateError::NoMirrorImage { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)

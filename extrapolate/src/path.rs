@@ -3,6 +3,7 @@
 
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use tdex_format::extrapolation::Symmetry;
 
 /// How one extrapolated period is entered.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,6 +106,22 @@ impl Iterator for RecurrencePolicy {
         self.at_end_of = step.period();
         Some(step)
     }
+}
+
+/// Whether each step replays its period as the mirror image of the recording: under
+/// [`Symmetry::AxialMirror`] every jump enters the mirror image of the orientation it
+/// leaves (the first period, from `t1`, is the recording's own), so that no two periods
+/// joined by a pairing replay the same image; without a symmetry, never.
+pub fn mirrored(steps: &[Step], symmetry: Symmetry) -> Vec<bool> {
+    steps
+        .iter()
+        .scan(false, |mirrored, step| {
+            if symmetry == Symmetry::AxialMirror && matches!(step, Step::Jump { .. }) {
+                *mirrored = !*mirrored;
+            }
+            Some(*mirrored)
+        })
+        .collect()
 }
 
 /// `periods` each once, in increasing order.
@@ -211,6 +228,29 @@ mod tests {
             .take(20)
             .collect();
         assert_eq!(starts(&one), [2]);
+    }
+
+    #[test]
+    fn the_mirror_flips_the_image_at_every_jump_and_never_along_the_recording() {
+        let steps = RecurrencePolicy::steps(3, 11, 60);
+        let mirrored = super::mirrored(&steps, Symmetry::AxialMirror);
+        let mut image = false;
+        for (s, &m) in steps.iter().zip(&mirrored) {
+            if let Step::Jump { .. } = s {
+                image = !image;
+            }
+            assert_eq!(m, image);
+        }
+        // the first periods continue the recording from t1: its own image
+        assert_eq!(mirrored[..2], [false, false]);
+        assert!(mirrored.contains(&true));
+        // one recorded period: every period is a jump, the images alternate
+        let one = RecurrencePolicy::steps(1, 0, 5);
+        assert_eq!(
+            super::mirrored(&one, Symmetry::AxialMirror),
+            [true, false, true, false, true]
+        );
+        assert_eq!(super::mirrored(&one, Symmetry::None), [false; 5]);
     }
 
     #[test]

@@ -1,7 +1,7 @@
 //! Several recorded periods replayed along a recurrence path (issue 23), on synthetic
 //! recordings written with `RecordingWriter`: the identity through the recorded stretch, the
 //! path's seed, heat over 500 periods, `P' = 1` as the paper's method, the refusal of
-//! `P' > P`, streamed against in memory.
+//! `P' > P`, streamed against in memory; the axial mirror's images and pairings.
 
 use extrapolate::replay::{self, Bodies, Exchanges, Scheme};
 use extrapolate::{
@@ -11,7 +11,7 @@ use extrapolate::{
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};
-use tdex_format::extrapolation::Roles;
+use tdex_format::extrapolation::{Roles, Symmetry};
 use tdex_format::{
     AreaEncoding, CollisionRow, ExtrapolationReader, Fault, RecordingInfo, RecordingReader,
     RecordingWriter, Snapshot, FORMAT_VERSION,
@@ -138,7 +138,20 @@ impl Synthetic {
 
     /// Writes the first `periods` periods (with snapshots `t0 … t_periods`) to `path`.
     fn write(&self, path: &Path, periods: u32) -> PathBuf {
-        let mut writer = RecordingWriter::create(path, info(periods)).unwrap();
+        self.write_as(path, info(periods))
+    }
+
+    /// [`Synthetic::write`] as the recording of a tdex drum (its case has a `[drum]`): the
+    /// axial mirror is allowed.
+    fn write_drum(&self, path: &Path, periods: u32) -> PathBuf {
+        let mut info = info(periods);
+        info.case_resolved["drum"] = serde_json::json!({ "radius": 0.05, "length": 0.05 });
+        self.write_as(path, info)
+    }
+
+    fn write_as(&self, path: &Path, info: RecordingInfo) -> PathBuf {
+        let periods = info.recorded_periods;
+        let mut writer = RecordingWriter::create(path, info).unwrap();
         for s in &self.snapshots[..=periods as usize] {
             writer.write_snapshot(s).unwrap();
         }
@@ -165,6 +178,7 @@ fn request(recording: &Path, output: &Path, periods: u32) -> ExtrapolationReques
         recorded_periods: None,
         path_seed: None,
         jump_targets: None,
+        symmetry: tdex_format::extrapolation::Symmetry::None,
     }
 }
 
@@ -429,4 +443,138 @@ fn streamed_and_in_memory_give_the_same_temperatures_along_a_path() {
         });
         assert!(replayed(&two).iter().all(|&p| (1..=2).contains(&p)));
     }
+}
+
+/// `pos` with `y` negated: the mirror image in the drum's mid-plane.
+fn mirror(pos: &[[f64; 3]]) -> Vec<[f64; 3]> {
+    pos.iter().map(|&[x, y, z]| [x, -y, z]).collect()
+}
+
+#[test]
+fn the_axial_mirror_alternates_the_images_through_the_pairing_of_t1_with_the_mirrored_t0() {
+    let dir = tempfile::tempdir().unwrap();
+    let syn = Synthetic::new(1, 7);
+    let rec = syn.write_drum(&dir.path().join("run.mcap"), 1);
+    let info = info(1);
+    let bodies = Bodies::of(&info, &syn.snapshots[0]);
+    // the pairing every jump goes through: t1 to the mirror image of t0
+    let (t0, t1) = (&syn.snapshots[0], &syn.snapshots[1]);
+    let image = extrapolate::cache::start_image(t0, Symmetry::AxialMirror);
+    assert_eq!(image.pos, mirror(&t0.pos));
+    let g = extrapolate::cache::compute(&image, t1).unwrap().g;
+    let plain = extrapolate::cache::compute(t0, t1).unwrap().g;
+    assert_ne!(g, plain, "the mirror image is paired otherwise");
+    let mut table = Exchanges::default();
+    for r in &syn.rows[0] {
+        table.push_row(r, &info, 0);
+    }
+    for scheme in Scheme::ALL {
+        let out = dir.path().join("m.mcap");
+        let outcome = run(&ExtrapolationRequest {
+            scheme,
+            symmetry: Symmetry::AxialMirror,
+            ..request(&rec, &out, 6)
+        });
+        assert_eq!(outcome.symmetry, Symmetry::AxialMirror);
+        let snaps = snapshots(&out);
+        let written = ExtrapolationReader::open(&out).unwrap().info().clone();
+        assert_eq!(written.symmetry, Symmetry::AxialMirror);
+        assert!(matches!(written.roles, Roles::Pairing(_)));
+        let mut expected = t1.temp.clone();
+        let mut ids: Vec<u32> = (0..N as u32).collect();
+        let mut next = Vec::new();
+        assert_eq!(snaps.len(), 7, "t1 … t7");
+        for (k, s) in snaps.iter().enumerate().skip(1) {
+            replay::move_to_roles(&expected, &g, &mut next).unwrap();
+            std::mem::swap(&mut expected, &mut next);
+            let mut moved = Vec::new();
+            replay::move_to_roles(&ids, &g, &mut moved).unwrap();
+            ids = moved;
+            replay::apply_rows(&mut expected, &table, &bodies, scheme);
+            assert_eq!(bits(&s.temp), bits(&expected), "{scheme:?} at t{}", k + 1);
+            // odd periods are the mirror image of the recording, even ones the recording
+            let (pos, vel) = if k % 2 == 1 {
+                (mirror(&t1.pos), mirror(&t1.vel))
+            } else {
+                (t1.pos.clone(), t1.vel.clone())
+            };
+            assert_eq!((&s.pos, &s.vel), (&pos, &vel), "t{}", k + 1);
+            assert_eq!(s.id, ids, "the particles move with their heat");
+        }
+        let start = replay::total_heat(&t1.temp, &bodies);
+        assert!(((outcome.total_heat_end - start) / start).abs() < 1e-12);
+    }
+    // the mirror's pairing in its own sidecar, the plain one untouched
+    assert!(tdex_format::sidecar::path_to_mirror_image(&rec, 1, 0).exists());
+    assert!(!dir.path().join("run.mcap.pairing.json").exists());
+    // without the mirror: the paper's method, another result
+    let plain_out = dir.path().join("p.mcap");
+    run(&request(&rec, &plain_out, 6));
+    assert!(dir.path().join("run.mcap.pairing.json").exists());
+    assert_ne!(
+        snapshots(&plain_out)[6].temp,
+        snapshots(&dir.path().join("m.mcap"))[6].temp
+    );
+}
+
+#[test]
+fn along_a_path_the_mirror_flips_the_image_at_every_jump() {
+    let dir = tempfile::tempdir().unwrap();
+    let syn = Synthetic::new(3, 8);
+    let rec = syn.write_drum(&dir.path().join("run.mcap"), 3);
+    let out = dir.path().join("m.mcap");
+    run(&ExtrapolationRequest {
+        symmetry: Symmetry::AxialMirror,
+        ..request(&rec, &out, 40)
+    });
+    let path = replayed(&out);
+    let snaps = snapshots(&out);
+    let mut mirrored = false;
+    let mut previous = 1;
+    for (k, &p) in path.iter().enumerate() {
+        if p != previous + 1 {
+            mirrored = !mirrored;
+        }
+        previous = p;
+        let end = &syn.snapshots[p as usize].pos;
+        let expected = if mirrored { mirror(end) } else { end.clone() };
+        assert_eq!(snaps[k + 1].pos, expected, "t{}", k + 2);
+    }
+    assert!(path.windows(2).filter(|w| w[1] != w[0] + 1).count() > 5);
+    // each start jumped to is paired with its mirror image, in sidecars of their own
+    let Roles::Path(p) = ExtrapolationReader::open(&out)
+        .unwrap()
+        .info()
+        .roles
+        .clone()
+    else {
+        panic!("a path")
+    };
+    for q in &p.pairings {
+        assert!(tdex_format::sidecar::path_to_mirror_image(&rec, 3, q.start).exists());
+        assert!(!tdex_format::sidecar::path_between(&rec, 3, q.start).exists());
+    }
+}
+
+#[test]
+fn the_axial_mirror_is_refused_for_a_recording_without_a_drum() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = Synthetic::new(1, 9).write(&dir.path().join("run.mcap"), 1);
+    let out = dir.path().join("x.mcap");
+    let e = extrapolate_recording(
+        &ExtrapolationRequest {
+            symmetry: Symmetry::AxialMirror,
+            ..request(&rec, &out, 3)
+        },
+        |_| {},
+    )
+    .unwrap_err();
+    assert!(matches!(e, ExtrapolateError::NoMirrorImage { .. }), "{e}");
+    assert_eq!(extrapolate::fault_of(&e), Some(Fault::Input));
+    let text = e.to_string();
+    assert!(
+        text.contains("run.mcap") && text.contains("[drum]"),
+        "{text}"
+    );
+    assert!(!out.exists());
 }

@@ -205,6 +205,12 @@ pub struct ExtrapolateArgs {
         value_parser = periods_used()
     )]
     pub jump_to: Option<Vec<u32>>,
+    /// Use the drum's mirror symmetry (its mid-plane y = 0): every jump enters the mirror
+    /// image of the recorded start, so the periods replayed alternate between the recording
+    /// and its mirror image (docs/method.md §6). Costs one more pairing per start; needs a
+    /// tdex drum.
+    #[arg(long)]
+    pub mirror: bool,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

@@ -12,6 +12,7 @@ use extrapolate::replay::Scheme;
 use recorder::record::RecordOptions;
 use recorder::Case;
 use std::path::PathBuf;
+use tdex_format::extrapolation::Symmetry;
 use tdex_format::{AreaEncoding, RecordingReader};
 
 /// Flags that do not fit the case or each other, or outputs that cannot be written
@@ -182,6 +183,8 @@ pub struct ExtrapolatePlan {
     pub seed: Option<u64>,
     /// `--jump-to`: the periods a jump may enter (`None`: all the periods used).
     pub jump_to: Option<Vec<u32>>,
+    /// `--mirror`: the drum's mirror symmetry used at the jumps.
+    pub symmetry: Symmetry,
     pub json: bool,
 }
 
@@ -402,6 +405,11 @@ impl ExtrapolatePlan {
             recorded_periods: args.recorded_periods,
             seed: args.seed,
             jump_to: args.jump_to,
+            symmetry: if args.mirror {
+                Symmetry::AxialMirror
+            } else {
+                Symmetry::None
+            },
             json: args.json,
         })
     }

@@ -8,6 +8,7 @@ use super::prediction::{Point, Prediction};
 use crate::compare::{Comparison, ContrastKind, PeriodComparison};
 use crate::fmt::trim_zeros;
 use tdex_format::extrapolation::Roles;
+use tdex_format::extrapolation::Symmetry;
 use tdex_format::{ExtrapolationInfo, RecordingInfo, RecordingSummary};
 
 /// Columns of the error table before it continues in a second table.
@@ -288,32 +289,44 @@ pub fn document(inp: &Inputs) -> Document {
             "none".into()
         }
     };
-    let pairing_row =
-        match &inp.extrapolation.roles {
-            Roles::Pairing(pairing) => {
-                let mean = Some(pairing.mean_distance_diameters);
-                let certified = Some(pairing.certified);
-                let seconds = pairing.seconds;
-                row(
-                    "Pairing of t0 and t1",
-                    format!(
-                        "mean distance {} diameters; certified optimal: {}; computed in {} s",
-                        opt(mean, |m| sig(m, 4)),
-                        certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
-                        opt(seconds, secs),
-                    ),
+    let pairing_row = match &inp.extrapolation.roles {
+        Roles::Pairing(pairing) => {
+            let mean = Some(pairing.mean_distance_diameters);
+            let certified = Some(pairing.certified);
+            let seconds = pairing.seconds;
+            let symmetry = inp.extrapolation.symmetry;
+            row(
+                match symmetry {
+                    Symmetry::None => "Pairing of t0 and t1",
+                    Symmetry::AxialMirror => "Pairing of t1 and the mirror image of t0",
+                },
+                format!(
+                    "{}mean distance {} diameters; certified optimal: {}; computed in {} s",
+                    crate::extrapolation::symmetry_words(symmetry)
+                        .map_or(String::new(), |w| format!("{w}; ")),
+                    opt(mean, |m| sig(m, 4)),
+                    certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
+                    opt(seconds, secs),
+                ),
+            )
+        }
+        Roles::Path(path) => row(
+            "Recurrence path",
+            std::iter::once(crate::extrapolation::path_words(path))
+                .chain(
+                    crate::extrapolation::symmetry_words(inp.extrapolation.symmetry)
+                        .map(String::from),
                 )
-            }
-            Roles::Path(path) => row(
-                "Recurrence path",
-                std::iter::once(crate::extrapolation::path_words(path))
-                    .chain(path.pairings.iter().map(|p| {
-                        format!("pairing {}", crate::extrapolation::path_pairing_words(p))
-                    }))
-                    .collect::<Vec<_>>()
-                    .join("; "),
-            ),
-        };
+                .chain(path.pairings.iter().map(|p| {
+                    format!(
+                        "pairing {}",
+                        crate::extrapolation::path_pairing_words(p, inp.extrapolation.symmetry)
+                    )
+                }))
+                .collect::<Vec<_>>()
+                .join("; "),
+        ),
+    };
     let groups = if p.hot_particles + p.cold_particles > 0 {
         format!(
             "{} ({} initially hot, {} initially cold)",

@@ -121,6 +121,7 @@ pub fn run(
             recorded_periods: Some(p),
             path_seed: seed,
             jump_targets: None,
+            symmetry: tdex_format::extrapolation::Symmetry::None,
         };
         crate::with_workers(plan.threads, || {
             Ok(extrapolate::extrapolate_recording(

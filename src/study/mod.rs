@@ -116,6 +116,7 @@ pub fn evaluate(
         recorded_periods: None,
         path_seed: None,
         jump_targets: None,
+        symmetry: tdex_format::extrapolation::Symmetry::None,
     };
     if let Err(e) = crate::with_workers(threads, || {
         Ok(extrapolate::extrapolate_recording(

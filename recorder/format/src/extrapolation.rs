@@ -32,6 +32,45 @@ pub struct ExtrapolationInfo {
     /// several recorded periods existed.
     #[serde(flatten)]
     pub roles: Roles,
+    /// The drum's symmetry the replay used; absent (the files before it) for none.
+    #[serde(default, skip_serializing_if = "Symmetry::is_none")]
+    pub symmetry: Symmetry,
+}
+
+/// A symmetry of the drum an extrapolation uses to vary the periods it replays.
+///
+/// A tdex drum (axis `y` through the origin, end caps at `y = ±L/2` moving alike, gravity
+/// `−z`, a mantle heated uniformly if at all) is its own mirror image in its mid-plane
+/// `y = 0`, and the mirror keeps the sense of rotation (an angular velocity along `y`
+/// is unchanged by `y → −y`). The mirror image of a recorded period is then a period of the
+/// same flow as likely as the recorded one: the same contacts between the same particles,
+/// at positions `(x, −y, z)`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Symmetry {
+    /// Every jump enters the recorded start itself: the paper's method.
+    #[default]
+    None,
+    /// Every jump enters the mirror image of its start (`y → −y`), so that the periods
+    /// replayed alternate between the recording and its mirror image at every jump: the
+    /// pairings are of the end snapshot to the mirrored starts, and a period entered by an
+    /// odd number of jumps is written with its positions and velocities mirrored.
+    AxialMirror,
+}
+
+impl Symmetry {
+    pub fn is_none(&self) -> bool {
+        *self == Symmetry::None
+    }
+
+    /// `pos` and `vel` as the period's image: unchanged, or with `y` negated.
+    pub fn image_of(self, mirrored: bool, pos: &mut [[f64; 3]], vel: &mut [[f64; 3]]) {
+        if self == Symmetry::AxialMirror && mirrored {
+            for p in pos.iter_mut().chain(vel.iter_mut()) {
+                p[1] = -p[1];
+            }
+        }
+    }
 }
 
 /// How an extrapolation moved the temperatures to their roles at the period boundaries.

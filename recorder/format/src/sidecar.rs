@@ -95,6 +95,15 @@ pub fn path_between(recording: &Path, end: u32, start: u32) -> PathBuf {
     PathBuf::from(name)
 }
 
+/// The sidecar of the pairing of snapshot `t_end` to the mirror image (`y → −y`) of
+/// `t_start` ([`crate::extrapolation::Symmetry::AxialMirror`]): the path with
+/// `.pairing.t<end>-mirror-t<start>.json` appended, apart from the plain pairings' names.
+pub fn path_to_mirror_image(recording: &Path, end: u32, start: u32) -> PathBuf {
+    let mut name = recording.as_os_str().to_owned();
+    name.push(format!(".pairing.t{end}-mirror-t{start}.json"));
+    PathBuf::from(name)
+}
+
 /// Reads the sidecar `path` of a recording of `particles` particles; `Ok(None)` if there is
 /// no such file.
 pub fn read(path: &Path, particles: usize) -> Result<Option<StoredPairing>, SidecarError> {
