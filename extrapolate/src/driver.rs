@@ -412,8 +412,10 @@ fn case_seed(info: &RecordingInfo) -> u64 {
 
 /// Whether the recording is of a tdex drum, whose mid-plane `y = 0` is a mirror plane
 /// ([`Symmetry`]): its case (recorded, or the case an import was made with) has a `[drum]`.
-/// A future drum feature that breaks the mirror (an inclined axis, a feed at one end, a
-/// mantle heated along part of its length) must be refused here.
+/// The mirror swaps the two end caps, which is harmless because they move alike and conduct
+/// no heat (a wall row of a cap moves none). A future drum feature that breaks the mirror
+/// (an inclined axis, a feed at one end, a heated cap, a mantle heated along part of its
+/// length) must be refused here.
 fn is_tdex_drum(info: &RecordingInfo) -> bool {
     info.case_resolved
         .get("drum")
