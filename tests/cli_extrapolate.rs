@@ -244,11 +244,19 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
         let report = json_of(&o);
         assert_eq!(report["symmetry"], "axial_mirror");
         assert_eq!(report["pairing"]["certified"], true);
+        // the check: the mirrored pairing's mean distance beside the plain one's
+        let check = &report["mirror_check"][0];
+        assert_eq!(
+            check["mirrored_mean_diameters"],
+            report["pairing"]["mean_distance_diameters"]
+        );
+        assert!(check["plain_mean_diameters"].as_f64().unwrap() > 0.0);
         files.push(std::fs::read(&out).unwrap());
         std::fs::remove_file(dir.path().join("run.mcap.pairing.t1-mirror-t0.json")).unwrap();
+        std::fs::remove_file(dir.path().join("run.mcap.pairing.json")).unwrap();
     }
     assert!(files[0] == files[1], "the mirror depends on the threads");
-    // the mirror's pairing has a sidecar of its own; the plain pairing's is not touched
+    // the mirror's pairing has a sidecar of its own, beside the plain one of its check
     let m = dir.path().join("m.mcap");
     let text = tdex_ok(&[
         "extrapolate",
@@ -261,21 +269,23 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
     ]);
     assert!(
         text.contains("pairing       t1 to the mirror image of t0: mean distance")
-            && text.contains("symmetry      axial mirror"),
+            && text.contains("symmetry      axial mirror")
+            && text.contains("mirror check  t1 to t0: mean distance"),
         "{text}"
     );
     assert!(dir
         .path()
         .join("run.mcap.pairing.t1-mirror-t0.json")
         .exists());
-    assert!(!dir.path().join("run.mcap.pairing.json").exists());
+    assert!(dir.path().join("run.mcap.pairing.json").exists());
     let inspected = tdex_ok(&["inspect", m.to_str().unwrap()]);
     assert!(
         inspected.contains("t1 to the mirror image of t0") && inspected.contains("axial mirror"),
         "{inspected}"
     );
-    // without the flag: no symmetry, and the plain pairing
+    // without the flag: no symmetry, no check
     let plain = dir.path().join("p.mcap");
-    assert_eq!(json_of(&extrapolate(&run, &plain, &[]))["symmetry"], "none");
-    assert!(dir.path().join("run.mcap.pairing.json").exists());
+    let report = json_of(&extrapolate(&run, &plain, &[]));
+    assert_eq!(report["symmetry"], "none");
+    assert!(report.get("mirror_check").is_none());
 }

@@ -84,10 +84,31 @@ pub struct ExtrapolationOutcome {
     /// computed (with their times) or as stored.
     pub roles: Roles,
     pub symmetry: Symmetry,
+    /// With the axial mirror: each start's mirrored pairing beside its plain one.
+    pub mirror_check: Vec<MirrorCheck>,
     pub costs: ExtrapolationCosts,
     /// `Σ C T` at `t1` and after the last period (J).
     pub total_heat_t1: f64,
     pub total_heat_end: f64,
+}
+
+/// How far the axial mirror's pairing of `t_end` to the mirrored `t_start` moves the
+/// particles, beside the plain pairing of the same snapshots: a bed that is its own mirror
+/// image gives about the same mean distance; a bed that leans along the axis a longer one,
+/// and the mirror's jumps then move heat along the axis.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct MirrorCheck {
+    pub end: u32,
+    pub start: u32,
+    pub plain_mean_diameters: f64,
+    pub mirrored_mean_diameters: f64,
+}
+
+impl MirrorCheck {
+    /// The mirrored pairing's mean distance over the plain one's.
+    pub fn ratio(&self) -> f64 {
+        self.mirrored_mean_diameters / self.plain_mean_diameters.max(f64::MIN_POSITIVE)
+    }
 }
 
 /// A pairing the path needs: of the end snapshot `t_P'` to the start of recorded period
@@ -226,6 +247,37 @@ pub fn extrapolate_recording(
             }
         };
         pairings.push(PathStart { period, stored });
+    }
+    // the mirror holds only if the bed is its own mirror image at the recorded instants: its
+    // mirrored pairing is then as short as the plain one, which is computed (or reused) to
+    // say so
+    let mut mirror_check = Vec::new();
+    if request.symmetry == Symmetry::AxialMirror {
+        let end = &snaps[used as usize];
+        for p in &pairings {
+            let start = &snaps[p.period as usize - 1];
+            let plain = match cache::load(&reader, start, end) {
+                Some(stored) => stored,
+                None => {
+                    let started = Instant::now();
+                    let mut stored = cache::compute(start, end)?;
+                    if request.reproducible {
+                        stored.summary = stored.summary.reproducible();
+                    }
+                    if let Err(e) = cache::store(&reader, end.index, start.index, &stored) {
+                        notice(Notice::PairingNotStored(&e));
+                    }
+                    seconds_pairing += started.elapsed().as_secs_f64();
+                    stored
+                }
+            };
+            mirror_check.push(MirrorCheck {
+                end: used,
+                start: p.period - 1,
+                plain_mean_diameters: plain.summary.mean_distance_diameters,
+                mirrored_mean_diameters: p.stored.summary.mean_distance_diameters,
+            });
+        }
     }
     let pairing_of = |period: u32| {
         pairings
@@ -395,6 +447,7 @@ pub fn extrapolate_recording(
         limit,
         roles: path_of(&|s: &StoredPairing| s.summary.clone()),
         symmetry: request.symmetry,
+        mirror_check,
         costs,
         total_heat_t1: heat_t1,
         total_heat_end: temps.total_heat(&bodies),

@@ -461,8 +461,16 @@ fn the_axial_mirror_alternates_the_images_through_the_pairing_of_t1_with_the_mir
     let (t0, t1) = (&syn.snapshots[0], &syn.snapshots[1]);
     let image = extrapolate::cache::start_image(t0, Symmetry::AxialMirror);
     assert_eq!(image.pos, mirror(&t0.pos));
-    let g = extrapolate::cache::compute(&image, t1).unwrap().g;
-    let plain = extrapolate::cache::compute(t0, t1).unwrap().g;
+    let mirrored = extrapolate::cache::compute(&image, t1).unwrap();
+    let plain = extrapolate::cache::compute(t0, t1).unwrap();
+    let g = mirrored.g.clone();
+    let check = extrapolate::MirrorCheck {
+        end: 1,
+        start: 0,
+        plain_mean_diameters: plain.summary.mean_distance_diameters,
+        mirrored_mean_diameters: mirrored.summary.mean_distance_diameters,
+    };
+    let plain = plain.g;
     assert_ne!(g, plain, "the mirror image is paired otherwise");
     let mut table = Exchanges::default();
     for r in &syn.rows[0] {
@@ -476,6 +484,8 @@ fn the_axial_mirror_alternates_the_images_through_the_pairing_of_t1_with_the_mir
             ..request(&rec, &out, 6)
         });
         assert_eq!(outcome.symmetry, Symmetry::AxialMirror);
+        // the mirrored pairing stated beside the plain one of the same snapshots
+        assert_eq!(outcome.mirror_check, [check]);
         let snaps = snapshots(&out);
         let written = ExtrapolationReader::open(&out).unwrap().info().clone();
         assert_eq!(written.symmetry, Symmetry::AxialMirror);
@@ -504,13 +514,12 @@ fn the_axial_mirror_alternates_the_images_through_the_pairing_of_t1_with_the_mir
         let start = replay::total_heat(&t1.temp, &bodies);
         assert!(((outcome.total_heat_end - start) / start).abs() < 1e-12);
     }
-    // the mirror's pairing in its own sidecar, the plain one untouched
+    // the mirror's pairing in its own sidecar, and the plain one its check used in its own
     assert!(tdex_format::sidecar::path_to_mirror_image(&rec, 1, 0).exists());
-    assert!(!dir.path().join("run.mcap.pairing.json").exists());
-    // without the mirror: the paper's method, another result
-    let plain_out = dir.path().join("p.mcap");
-    run(&request(&rec, &plain_out, 6));
     assert!(dir.path().join("run.mcap.pairing.json").exists());
+    // without the mirror: the paper's method, another result, and no check
+    let plain_out = dir.path().join("p.mcap");
+    assert!(run(&request(&rec, &plain_out, 6)).mirror_check.is_empty());
     assert_ne!(
         snapshots(&plain_out)[6].temp,
         snapshots(&dir.path().join("m.mcap"))[6].temp
@@ -552,7 +561,6 @@ fn along_a_path_the_mirror_flips_the_image_at_every_jump() {
     };
     for q in &p.pairings {
         assert!(tdex_format::sidecar::path_to_mirror_image(&rec, 3, q.start).exists());
-        assert!(!tdex_format::sidecar::path_between(&rec, 3, q.start).exists());
     }
 }
 
