@@ -224,32 +224,37 @@ pub fn extrapolate_recording(
     let mut seconds_pairing = 0.0;
     let mut reused = true;
     let mut pairings = Vec::with_capacity(stored.len());
+    // computes the pairing of `end` to `start` (an image under `symmetry`) and stores it
+    // beside the recording; the stored pairing only saves time next run, so a recording on
+    // a full or read-only disk is still extrapolated
+    let mut compute_and_store = |start: &Snapshot,
+                                 end: &Snapshot,
+                                 symmetry: Symmetry|
+     -> Result<StoredPairing, ExtrapolateError> {
+        let started = Instant::now();
+        let mut stored = cache::compute(start, end)?;
+        if request.reproducible {
+            stored.summary = stored.summary.reproducible();
+        }
+        if let Err(e) = cache::store_image(&reader, end.index, start.index, symmetry, &stored) {
+            notice(Notice::PairingNotStored(&e));
+        }
+        seconds_pairing += started.elapsed().as_secs_f64();
+        Ok(stored)
+    };
     for (period, found) in stored.drain(..) {
         let stored = match found {
             Some(stored) => stored,
             None => {
                 reused = false;
-                let started = Instant::now();
-                let (start, end) = (start_image(period), &snaps[used as usize]);
-                let mut stored = cache::compute(&start, end)?;
-                if request.reproducible {
-                    stored.summary = stored.summary.reproducible();
-                }
-                // the stored pairing only saves time next run: a recording on a full or
-                // read-only disk is still extrapolated
-                if let Err(e) =
-                    cache::store_image(&reader, end.index, start.index, request.symmetry, &stored)
-                {
-                    notice(Notice::PairingNotStored(&e));
-                }
-                seconds_pairing += started.elapsed().as_secs_f64();
-                stored
+                let start = start_image(period);
+                compute_and_store(&start, &snaps[used as usize], request.symmetry)?
             }
         };
         pairings.push(PathStart { period, stored });
     }
     // the mirror holds only if the bed is its own mirror image at the recorded instants: its
-    // mirrored pairing is then as short as the plain one, which is computed (or reused) to
+    // mirrored pairing is then as short as the plain one, which is reused or computed to
     // say so
     let mut mirror_check = Vec::new();
     if request.symmetry == Symmetry::AxialMirror {
@@ -258,18 +263,7 @@ pub fn extrapolate_recording(
             let start = &snaps[p.period as usize - 1];
             let plain = match cache::load(&reader, start, end) {
                 Some(stored) => stored,
-                None => {
-                    let started = Instant::now();
-                    let mut stored = cache::compute(start, end)?;
-                    if request.reproducible {
-                        stored.summary = stored.summary.reproducible();
-                    }
-                    if let Err(e) = cache::store(&reader, end.index, start.index, &stored) {
-                        notice(Notice::PairingNotStored(&e));
-                    }
-                    seconds_pairing += started.elapsed().as_secs_f64();
-                    stored
-                }
+                None => compute_and_store(start, end, Symmetry::None)?,
             };
             mirror_check.push(MirrorCheck {
                 end: used,
