@@ -124,11 +124,10 @@ const MIRROR_LONGER_AT_MOST: f64 = 1.1;
 /// A mirror check in plain words, with its verdict.
 pub fn mirror_check_words(c: &extrapolate::MirrorCheck) -> String {
     let verdict = if c.ratio() <= MIRROR_LONGER_AT_MOST {
-        "the bed is its own mirror image to within 10 %".to_string()
+        "the bed is its own mirror image to within 10 %"
     } else {
         "the bed is not its own mirror image, so the mirror's jumps move the particles, and \
          their heat, further than the plain pairing does: extrapolate without --mirror"
-            .to_string()
     };
     format!(
         "t{} to t{}: mean distance {} diameters plain, {} to the mirror image ({} times): {verdict}",

@@ -41,7 +41,13 @@ fn record(dir: &Path, case: &str, flags: &[&str]) -> PathBuf {
     run
 }
 
+/// `tdex extrapolate RUN --periods 3 -o OUT --json EXTRA…`.
 fn extrapolate(run: &Path, out: &Path, extra: &[&str]) -> Output {
+    extrapolate_printing(run, out, &[&["--json"], extra].concat())
+}
+
+/// `tdex extrapolate RUN --periods 3 -o OUT EXTRA…`: the summary as printed for a reader.
+fn extrapolate_printing(run: &Path, out: &Path, extra: &[&str]) -> Output {
     let mut args = vec![
         "extrapolate",
         run.to_str().unwrap(),
@@ -49,7 +55,6 @@ fn extrapolate(run: &Path, out: &Path, extra: &[&str]) -> Output {
         "3",
         "-o",
         out.to_str().unwrap(),
-        "--json",
     ];
     args.extend_from_slice(extra);
     run_tdex(&args)
@@ -258,15 +263,9 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
     assert!(files[0] == files[1], "the mirror depends on the threads");
     // the mirror's pairing has a sidecar of its own, beside the plain one of its check
     let m = dir.path().join("m.mcap");
-    let text = tdex_ok(&[
-        "extrapolate",
-        run.to_str().unwrap(),
-        "--periods",
-        "3",
-        "-o",
-        m.to_str().unwrap(),
-        "--mirror",
-    ]);
+    let printed = extrapolate_printing(&run, &m, &["--mirror"]);
+    assert!(printed.status.success());
+    let text = String::from_utf8(printed.stdout).unwrap();
     assert!(
         text.contains("pairing       t1 to the mirror image of t0: mean distance")
             && text.contains("symmetry      axial mirror")

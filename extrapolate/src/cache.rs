@@ -6,6 +6,7 @@
 use crate::pairing::{self, PairingOptions};
 use crate::sidecar::{self, PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
+use std::borrow::Cow;
 use std::hash::Hasher;
 use std::path::PathBuf;
 use tdex_format::extrapolation::Symmetry;
@@ -70,12 +71,18 @@ pub fn load(reader: &RecordingReader, t0: &Snapshot, t1: &Snapshot) -> Option<St
     load_image(reader, t0, t1, Symmetry::None)
 }
 
-/// The image of snapshot `start` a jump under `symmetry` enters: the snapshot itself, or
-/// its mirror image (`y → −y` on positions and velocities), with its index.
-pub fn start_image(start: &Snapshot, symmetry: Symmetry) -> Snapshot {
-    let mut image = start.clone();
-    symmetry.image_of(true, &mut image.pos, &mut image.vel);
-    image
+/// The image of snapshot `start` a jump under `symmetry` enters: the snapshot itself
+/// (borrowed: the paper's method copies nothing), or its mirror image (`y → −y` on
+/// positions and velocities), with its index.
+pub fn start_image(start: &Snapshot, symmetry: Symmetry) -> Cow<'_, Snapshot> {
+    match symmetry {
+        Symmetry::None => Cow::Borrowed(start),
+        Symmetry::AxialMirror => {
+            let mut image = start.clone();
+            symmetry.image_of(true, &mut image.pos, &mut image.vel);
+            Cow::Owned(image)
+        }
+    }
 }
 
 /// Where the pairing of snapshot `end` to (the image under `symmetry` of) snapshot `start`

@@ -7,8 +7,7 @@ use super::document::{bold, code, link, para, text, Block, Document};
 use super::prediction::{Point, Prediction};
 use crate::compare::{Comparison, ContrastKind, PeriodComparison};
 use crate::fmt::trim_zeros;
-use tdex_format::extrapolation::Roles;
-use tdex_format::extrapolation::Symmetry;
+use tdex_format::extrapolation::{Roles, Symmetry};
 use tdex_format::{ExtrapolationInfo, RecordingInfo, RecordingSummary};
 
 /// Columns of the error table before it continues in a second table.
