@@ -395,6 +395,57 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
         assert_eq!(a["outside_range"], b["outside_range"]);
     }
 
+    // with --mirror every P runs twice, the paper's method first (the same figures as
+    // without the flag) and then the mirror image, with its check; each has its own file
+    let mirrored = dir.path().join("mirrored");
+    let json3 = ok(&[
+        "study",
+        "horizon",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "1,2",
+        "--mirror",
+        "--json",
+        "-o",
+        mirrored.to_str().unwrap(),
+    ]);
+    let study3: serde_json::Value = serde_json::from_str(&json3).unwrap();
+    let runs3 = study3["runs"].as_array().unwrap();
+    let shape: Vec<(u64, &str)> = runs3
+        .iter()
+        .map(|r| {
+            (
+                r["recorded_periods"].as_u64().unwrap(),
+                r["symmetry"].as_str().unwrap(),
+            )
+        })
+        .collect();
+    assert_eq!(
+        shape,
+        [
+            (1, "none"),
+            (1, "axial_mirror"),
+            (2, "none"),
+            (2, "axial_mirror")
+        ]
+    );
+    for (plain, again) in runs.iter().zip([&runs3[0], &runs3[2]]) {
+        assert_eq!(plain["median_ratio"], again["median_ratio"]);
+        assert!(again.get("mirror_check").is_none(), "{again}");
+    }
+    for (mirror, starts) in [(&runs3[1], 1), (&runs3[3], 2)] {
+        assert_ne!(mirror["extrapolation"], runs3[0]["extrapolation"]);
+        let checks = mirror["mirror_check"].as_array().unwrap();
+        // one check per start the path jumps to
+        assert!((1..=starts).contains(&checks.len()), "{mirror}");
+        for c in checks {
+            assert!(c["mirrored_mean_diameters"].as_f64().unwrap() > 0.0, "{c}");
+        }
+        assert!(Path::new(mirror["extrapolation"].as_str().unwrap()).exists());
+    }
+    let md = std::fs::read_to_string(mirrored.join("study.md")).unwrap();
+    assert!(md.contains("P = 2, mirror: mirror check t"), "{md}");
+
     // a recording has its own reference periods; it cannot replay more periods than it holds
     for (flags, expect) in [
         (vec!["--reference", "5"], "--reference: "),

@@ -575,6 +575,11 @@ pub struct HorizonStudyArgs {
     /// Seed of the recurrence paths (default: the case's seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Run every P twice: as the paper does, and with the drum's mirror image entered at
+    /// every jump (`tdex extrapolate --mirror`, docs/method.md §6), so that the table says
+    /// which of the two passes as one more DEM run on this case.
+    #[arg(long)]
+    pub mirror: bool,
 }
 
 /// `tdex study regimes`.

@@ -118,6 +118,8 @@ pub enum StudyKind {
         recorded_periods: Vec<u32>,
         /// The recurrence paths' seed; `None`: the case's.
         seed: Option<u64>,
+        /// The images every P is run with: the paper's method, and the mirror if asked.
+        images: Vec<Symmetry>,
     },
     /// One recording per drum speed (the case with its rotation period replaced).
     Regimes {
@@ -819,6 +821,7 @@ impl StudyKind {
             twins,
             tau_rev,
             seed,
+            mirror,
         } = args;
         let mut recorded_periods = distinct(recorded_periods);
         recorded_periods.sort_unstable();
@@ -865,10 +868,16 @@ impl StudyKind {
                 HorizonSource::Record(options)
             }
         };
+        let images = if mirror {
+            vec![Symmetry::None, Symmetry::AxialMirror]
+        } else {
+            vec![Symmetry::None]
+        };
         Ok(StudyKind::Horizon {
             source,
             recorded_periods,
             seed,
+            images,
         })
     }
 

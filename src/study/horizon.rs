@@ -5,7 +5,8 @@
 //! The DEM runs once and records the largest P (or a recording made before is read): a
 //! smaller P replays the first P of its periods, which are the tables and snapshots a
 //! recording of P periods would hold (the recorder only reads the DEM's state), so every P
-//! is judged against the same DEM run and the same twins.
+//! is judged against the same DEM run and the same twins. With `--mirror` each P runs twice,
+//! as the paper does and with the drum's mirror image at every jump, on the same paths.
 
 use super::plots::{self, Line, LineKind};
 use crate::cli::{HorizonSource, StudyPlan};
@@ -13,16 +14,23 @@ use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
 use extrapolate::replay::Scheme;
-use extrapolate::{ExtrapolationRequest, TableChoice};
+use extrapolate::{ExtrapolationRequest, MirrorCheck, TableChoice};
 use recorder::record;
 use serde::Serialize;
 use std::path::Path;
+use tdex_format::extrapolation::Symmetry;
 use tdex_format::{ExtrapolationReader, RecordingCosts, RecordingReader};
 
-/// One number of recorded periods, extrapolated over the reference periods and judged.
+/// One number of recorded periods with one image at the jumps, extrapolated over the
+/// reference periods and judged.
 #[derive(Debug, Serialize)]
 struct Entry {
     recorded_periods: u32,
+    /// `none` (the paper's method) or `axial_mirror`.
+    symmetry: Symmetry,
+    /// With the mirror: each start's mirrored pairing beside its plain one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    mirror_check: Vec<MirrorCheck>,
     extrapolation: String,
     /// DEM seconds to `t0` plus the P recorded periods: what a recording of P periods costs
     /// (null without the recording's costs record).
@@ -66,6 +74,7 @@ pub fn run(
     source: &HorizonSource,
     recorded_periods: &[u32],
     seed: Option<u64>,
+    images: &[Symmetry],
 ) -> Result<()> {
     let dir = &plan.output;
     let recording = match source {
@@ -108,8 +117,14 @@ pub fn run(
         );
     }
     let mut runs = Vec::new();
-    for &p in recorded_periods {
-        let extra = dir.join(format!("horizon_p{p}.extra.mcap"));
+    for (&p, &symmetry) in recorded_periods
+        .iter()
+        .flat_map(|p| images.iter().map(move |s| (p, s)))
+    {
+        let extra = dir.join(match symmetry {
+            Symmetry::None => format!("horizon_p{p}.extra.mcap"),
+            Symmetry::AxialMirror => format!("horizon_p{p}_mirror.extra.mcap"),
+        });
         let request = ExtrapolationRequest {
             recording: recording.clone(),
             periods: info.reference_periods,
@@ -121,9 +136,9 @@ pub fn run(
             recorded_periods: Some(p),
             path_seed: seed,
             jump_targets: None,
-            symmetry: tdex_format::extrapolation::Symmetry::None,
+            symmetry,
         };
-        crate::with_workers(plan.threads, || {
+        let outcome = crate::with_workers(plan.threads, || {
             Ok(extrapolate::extrapolate_recording(
                 &request,
                 extrapolation::tell,
@@ -132,7 +147,10 @@ pub fn run(
         .with_context(|| format!("extrapolating with {p} recorded period(s)"))?;
         let ext = ExtrapolationReader::open(&extra)?;
         let comparison = compare::compare(&rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
-        runs.push(Entry::new(p, &extra, rec.costs(), comparison));
+        let mut entry = Entry::new(p, &extra, rec.costs(), comparison);
+        entry.symmetry = symmetry;
+        entry.mirror_check = outcome.mirror_check;
+        runs.push(entry);
     }
     let study = HorizonStudy {
         study: "horizon",
@@ -172,11 +190,21 @@ fn recording_seconds(costs: &RecordingCosts, p: u32) -> Option<f64> {
 }
 
 impl Entry {
+    /// `P = 2`, or `P = 2, mirror`: the run's name in the table and the plots.
+    fn label(&self) -> String {
+        match self.symmetry {
+            Symmetry::None => format!("P = {}", self.recorded_periods),
+            Symmetry::AxialMirror => format!("P = {}, mirror", self.recorded_periods),
+        }
+    }
+
     fn new(p: u32, extra: &Path, costs: Option<&RecordingCosts>, comparison: Comparison) -> Self {
         let v = &comparison.verdict;
         let last = comparison.periods.last();
         Entry {
             recorded_periods: p,
+            symmetry: Symmetry::None,
+            mirror_check: Vec::new(),
             extrapolation: extra.display().to_string(),
             recording_seconds: costs.and_then(|c| recording_seconds(c, p)),
             passes: v.passes,
@@ -202,8 +230,8 @@ fn opt(x: Option<f64>, digits: usize) -> String {
 fn table(s: &HorizonStudy) -> String {
     let last = s.reference_periods + 1;
     let mut t = format!(
-        "{:>2} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
-        "P",
+        "{:<13} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
+        "run",
         "recording (s)",
         "median ratio",
         "ratio range",
@@ -213,8 +241,8 @@ fn table(s: &HorizonStudy) -> String {
     );
     for e in &s.runs {
         t += &format!(
-            "{:>2} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
-            e.recorded_periods,
+            "{:<13} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
+            e.label(),
             opt(e.recording_seconds, 1),
             opt(e.median_ratio, 2),
             format!("{}–{}", opt(e.ratio_min, 2), opt(e.ratio_max, 2)),
@@ -232,7 +260,14 @@ fn table(s: &HorizonStudy) -> String {
         );
     }
     for e in &s.runs {
-        t += &format!("P = {}: {}\n", e.recorded_periods, e.verdict);
+        t += &format!("{}: {}\n", e.label(), e.verdict);
+        for check in &e.mirror_check {
+            t += &format!(
+                "{}: mirror check {}\n",
+                e.label(),
+                extrapolation::mirror_check_words(check)
+            );
+        }
     }
     if let Some(best) = s
         .runs
@@ -241,8 +276,8 @@ fn table(s: &HorizonStudy) -> String {
         .min_by(|a, b| a.median_ratio.unwrap().total_cmp(&b.median_ratio.unwrap()))
     {
         t += &format!(
-            "closest to one more DEM run: P = {} (median ratio {})\n",
-            best.recorded_periods,
+            "closest to one more DEM run: {} (median ratio {})\n",
+            best.label(),
             opt(best.median_ratio, 2)
         );
     }
@@ -254,7 +289,8 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
         "# Long-horizon study: {}\n\n{} particles, τ = {} s; the recording `{}` holds {} \
          recorded period(s), {} reference periods and {} DEM twin(s). Each row replays the \
          first P recorded periods along a recurrence path (seed: {}) over the {} reference \
-         periods and compares it with the DEM and its twins at every t_k (200 Voronoi cells \
+         periods (`mirror`: entering the drum's mirror image at every jump) and compares it \
+         with the DEM and its twins at every t_k (200 Voronoi cells \
          unless `--cells` says otherwise). ratio: the extrapolation's mean cell distance to \
          the DEM runs over the DEM runs' own mean distance; outside DEM range: the t_k where \
          it is farther from them than the two farthest DEM runs are from each other; means \
@@ -282,7 +318,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
         .enumerate()
         .map(|(n, e)| Line {
             kind: LineKind::Extrapolation(n),
-            label: format!("P = {}", e.recorded_periods),
+            label: e.label(),
             points: e
                 .comparison
                 .periods
@@ -346,7 +382,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             })
             .collect();
         push_means(
-            format!("extrapolated, P = {}", e.recorded_periods),
+            format!("extrapolated, {}", e.label()),
             LineKind::Extrapolation(n),
             &extrapolated,
         );

@@ -39,7 +39,8 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
             source,
             recorded_periods,
             seed,
-        } => horizon::run(plan, source, recorded_periods, *seed),
+            images,
+        } => horizon::run(plan, source, recorded_periods, *seed, images),
     }
 }
 
