@@ -234,6 +234,13 @@ fn reproducible_pairings_and_extrapolations_are_the_same_bytes_on_any_thread_cou
     assert!(!up_to_costs(&timed).is_empty());
 }
 
+/// The sidecars of `tdex extrapolate --mirror` on `run.mcap`: the mirror's pairing and the
+/// plain one its check compares it with.
+const MIRROR_SIDECARS: [&str; 2] = [
+    "run.mcap.pairing.t1-mirror-t0.json",
+    "run.mcap.pairing.json",
+];
+
 #[test]
 fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
     let dir = tempfile::tempdir().unwrap();
@@ -257,8 +264,30 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
         );
         assert!(check["plain_mean_diameters"].as_f64().unwrap() > 0.0);
         files.push(std::fs::read(&out).unwrap());
-        std::fs::remove_file(dir.path().join("run.mcap.pairing.t1-mirror-t0.json")).unwrap();
-        std::fs::remove_file(dir.path().join("run.mcap.pairing.json")).unwrap();
+        let sidecars = MIRROR_SIDECARS.map(|f| std::fs::read(dir.path().join(f)).unwrap());
+        // `tdex pair --mirror` computes the same two pairings, and says the same check
+        let paired: serde_json::Value = serde_json::from_str(&tdex_ok(&[
+            "pair",
+            run.to_str().unwrap(),
+            "--mirror",
+            "--reproducible",
+            "--json",
+            "--threads",
+            threads,
+        ]))
+        .unwrap();
+        assert_eq!(paired["mirror_check"], *check);
+        assert_eq!(
+            paired["mirror"]["mean_distance_diameters"],
+            check["mirrored_mean_diameters"]
+        );
+        for (f, before) in MIRROR_SIDECARS.iter().zip(&sidecars) {
+            assert!(
+                std::fs::read(dir.path().join(f)).unwrap() == *before,
+                "{f} differs"
+            );
+            std::fs::remove_file(dir.path().join(f)).unwrap();
+        }
     }
     assert!(files[0] == files[1], "the mirror depends on the threads");
     // the mirror's pairing has a sidecar of its own, beside the plain one of its check
@@ -287,4 +316,9 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
     let report = json_of(&extrapolate(&run, &plain, &[]));
     assert_eq!(report["symmetry"], "none");
     assert!(report.get("mirror_check").is_none());
+    let paired = tdex_ok(&["pair", run.to_str().unwrap(), "--mirror"]);
+    assert!(
+        paired.contains("mirror image  ") && paired.contains("mirror check  t1 to t0"),
+        "{paired}"
+    );
 }

@@ -138,7 +138,7 @@ pub fn extrapolate_recording(
             recorded: info.recorded_periods,
         });
     }
-    if request.symmetry == Symmetry::AxialMirror && !is_tdex_drum(&info) {
+    if request.symmetry == Symmetry::AxialMirror && !has_mirror_image(&info) {
         return Err(ExtrapolateError::NoMirrorImage {
             recording: request.recording.clone(),
         });
@@ -463,7 +463,7 @@ fn case_seed(info: &RecordingInfo) -> u64 {
 /// no heat (a wall row of a cap moves none). A future drum feature that breaks the mirror
 /// (an inclined axis, a feed at one end, a heated cap, a mantle heated along part of its
 /// length) must be refused here.
-fn is_tdex_drum(info: &RecordingInfo) -> bool {
+pub fn has_mirror_image(info: &RecordingInfo) -> bool {
     info.case_resolved
         .get("drum")
         .is_some_and(serde_json::Value::is_object)

@@ -153,6 +153,11 @@ pub struct PairArgs {
     /// then gives the same file byte for byte.
     #[arg(long)]
     pub reproducible: bool,
+    /// Also pair the end with the drum's mirror image of each start (what `tdex extrapolate
+    /// --mirror` uses, stored beside the recording) and say whether the bed is its own
+    /// mirror image: the mirror check.
+    #[arg(long)]
+    pub mirror: bool,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

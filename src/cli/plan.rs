@@ -166,6 +166,9 @@ pub struct PairPlan {
     pub file: PathBuf,
     pub threads: usize,
     pub reproducible: bool,
+    /// Also pair the end with each start's mirror image (`--mirror`), beside the plain
+    /// pairing the mirror check compares it with.
+    pub mirror: bool,
     pub json: bool,
 }
 
@@ -387,6 +390,7 @@ impl PairPlan {
             file: args.file,
             threads: workers(args.threads),
             reproducible: args.reproducible,
+            mirror: args.mirror,
             json: args.json,
         }
     }
