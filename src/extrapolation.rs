@@ -130,12 +130,13 @@ pub fn mirror_check_words(c: &extrapolate::MirrorCheck) -> String {
          their heat, further than the plain pairing does: extrapolate without --mirror"
     };
     format!(
-        "t{} to t{}: mean distance {} diameters plain, {} to the mirror image ({} times): {verdict}",
+        "t{} to t{}: mean distance {} diameters plain, {} to the mirror image ({:.3} times): {verdict}",
         c.end,
         c.start,
         crate::fmt::sig(c.plain_mean_diameters, 4),
         crate::fmt::sig(c.mirrored_mean_diameters, 4),
-        crate::fmt::sig(c.ratio(), 3),
+        // three decimals, so that a ratio just over the threshold does not read as on it
+        c.ratio(),
     )
 }
 

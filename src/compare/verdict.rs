@@ -42,6 +42,15 @@ pub(crate) fn num(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// A ratio said to exceed 1, with the decimals that show it does (`1.004`, not `1`).
+fn above_one(x: f64) -> String {
+    let mut decimals = 2;
+    while decimals < 6 && format!("{x:.decimals$}").parse::<f64>().unwrap_or(x) <= 1.0 {
+        decimals += 1;
+    }
+    format!("{x:.decimals$}")
+}
+
 /// A temperature difference in K with a precision fit for it.
 fn kelvin(x: f64) -> String {
     let digits = if x == 0.0 {
@@ -173,10 +182,13 @@ impl Verdict {
                 };
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}{}){beyond}{few}{means}",
+                     each other over {} (median {}){beyond}{few}{means}",
                     instants(&compared, compared.len()),
-                    num(m),
-                    if m > 1.0 { " > 1" } else { "" }
+                    if m > 1.0 {
+                        format!("{} > 1", above_one(m))
+                    } else {
+                        num(m)
+                    },
                 )
             }
             _ if floors => format!(
@@ -211,6 +223,8 @@ mod tests {
     fn numbers_are_written_without_float_noise() {
         assert_eq!(num(0.15000000000000002), "0.15");
         assert_eq!(num(1.0), "1");
+        assert_eq!(above_one(1.0015), "1.002");
+        assert_eq!(above_one(1.18), "1.18");
         assert_eq!(num(12.34), "12.3");
         assert_eq!(num(55769240392.9), "5.6e10");
         assert_eq!(kelvin(0.0812), "0.0812 K");

@@ -147,10 +147,14 @@ pub fn run(
         .with_context(|| format!("extrapolating with {p} recorded period(s)"))?;
         let ext = ExtrapolationReader::open(&extra)?;
         let comparison = compare::compare(&rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
-        let mut entry = Entry::new(p, &extra, rec.costs(), comparison);
-        entry.symmetry = symmetry;
-        entry.mirror_check = outcome.mirror_check;
-        runs.push(entry);
+        runs.push(Entry::new(
+            p,
+            symmetry,
+            outcome.mirror_check,
+            &extra,
+            rec.costs(),
+            comparison,
+        ));
     }
     let study = HorizonStudy {
         study: "horizon",
@@ -198,13 +202,34 @@ impl Entry {
         }
     }
 
-    fn new(p: u32, extra: &Path, costs: Option<&RecordingCosts>, comparison: Comparison) -> Self {
+    /// One colour per P, the mirror's line dashed in its P's colour.
+    fn line_kind(&self, runs: &[Entry]) -> LineKind {
+        let mut ps: Vec<u32> = runs.iter().map(|e| e.recorded_periods).collect();
+        ps.dedup();
+        let n = ps
+            .iter()
+            .position(|&p| p == self.recorded_periods)
+            .unwrap_or(0);
+        match self.symmetry {
+            Symmetry::None => LineKind::Extrapolation(n),
+            Symmetry::AxialMirror => LineKind::MirroredExtrapolation(n),
+        }
+    }
+
+    fn new(
+        p: u32,
+        symmetry: Symmetry,
+        mirror_check: Vec<MirrorCheck>,
+        extra: &Path,
+        costs: Option<&RecordingCosts>,
+        comparison: Comparison,
+    ) -> Self {
         let v = &comparison.verdict;
         let last = comparison.periods.last();
         Entry {
             recorded_periods: p,
-            symmetry: Symmetry::None,
-            mirror_check: Vec::new(),
+            symmetry,
+            mirror_check,
             extrapolation: extra.display().to_string(),
             recording_seconds: costs.and_then(|c| recording_seconds(c, p)),
             passes: v.passes,
@@ -315,9 +340,8 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
     let ratio_lines: Vec<Line> = s
         .runs
         .iter()
-        .enumerate()
-        .map(|(n, e)| Line {
-            kind: LineKind::Extrapolation(n),
+        .map(|e| Line {
+            kind: e.line_kind(&s.runs),
             label: e.label(),
             points: e
                 .comparison
@@ -368,7 +392,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             push_means(format!("DEM twin {}", m + 1), LineKind::DemRun, twin);
         }
     }
-    for (n, e) in s.runs.iter().enumerate() {
+    for e in &s.runs {
         let extrapolated: Vec<GroupMeans> = e
             .comparison
             .periods
@@ -383,7 +407,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             .collect();
         push_means(
             format!("extrapolated, {}", e.label()),
-            LineKind::Extrapolation(n),
+            e.line_kind(&s.runs),
             &extrapolated,
         );
     }

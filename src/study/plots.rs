@@ -6,6 +6,7 @@ use crate::report::plots::{
     axes, chart, legend, message, render, span, tick, COLD, FONT, GREY, HOT, SIZE,
 };
 use anyhow::Result;
+use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 
 /// Labelled points `(x, y, label)`; a message instead when there are none.
@@ -124,6 +125,9 @@ pub enum LineKind {
     /// Extrapolation number `n` (its hot and cold lines share it): the palette's `n`-th
     /// colour.
     Extrapolation(usize),
+    /// Extrapolation number `n` through the drum's mirror image: the colour of
+    /// [`LineKind::Extrapolation`]`(n)`, dashed, so that each variant sits beside its plain run.
+    MirroredExtrapolation(usize),
 }
 
 /// Labelled lines, one colour each, with an optional dashed horizontal reference line
@@ -169,20 +173,27 @@ pub fn lines(
                 .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK));
         }
         for s in series {
-            let colour = match s.kind {
-                LineKind::Dem => BLACK,
-                LineKind::DemRun => GREY,
-                LineKind::Extrapolation(n) => PALETTE[n % PALETTE.len()],
+            let (colour, dashed) = match s.kind {
+                LineKind::Dem => (BLACK, false),
+                LineKind::DemRun => (GREY, false),
+                LineKind::Extrapolation(n) => (PALETTE[n % PALETTE.len()], false),
+                LineKind::MirroredExtrapolation(n) => (PALETTE[n % PALETTE.len()], true),
             };
-            chart
-                .draw_series(LineSeries::new(
-                    s.points.iter().copied(),
-                    colour.stroke_width(2),
-                ))?
-                .label(s.label.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
-                });
+            let style = colour.stroke_width(2);
+            let points = s.points.iter().copied();
+            if dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(points, 6, 3, style))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| {
+                        DashedPathElement::new(vec![(x, y), (x + 20, y)], 6, 3, style)
+                    });
+            } else {
+                chart
+                    .draw_series(LineSeries::new(points, style))?
+                    .label(s.label.clone())
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            }
         }
         // the legend where the lines cross least, as in the report's plots
         let crossed: Vec<&[(f64, f64)]> = series.iter().map(|s| &s.points[..]).collect();
