@@ -35,6 +35,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
     // (P = 1: t1 to t0, the paper's pairing)
     let end = snapshot(&reader, last)?;
     let mut json = Vec::new();
+    let mut checks = Vec::new();
     for start in 0..last {
         let start = snapshot(&reader, start)?;
         let plain = pair(plan, &reader, &start, &end, Symmetry::None)?;
@@ -46,6 +47,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
                 plain_mean_diameters: plain.measured.mean_distance_diameters,
                 mirrored_mean_diameters: mirrored.measured.mean_distance_diameters,
             };
+            checks.push(check);
             Some((mirrored, check))
         } else {
             None
@@ -67,12 +69,14 @@ pub fn run(plan: &PairPlan) -> Result<()> {
             println!("t{} to t{}", end.index, start.index);
         }
         tell(&plain, "pairing");
-        if let Some((mirrored, check)) = &mirror {
+        if let Some((mirrored, _)) = &mirror {
             tell(mirrored, "mirror image");
-            println!(
-                "mirror check  {}",
-                crate::extrapolation::mirror_check_words(check)
-            );
+        }
+    }
+    // the verdict is on the path, which jumps to every start alike: after all of them
+    if !plan.json {
+        for line in crate::extrapolation::mirror_check_lines(&checks) {
+            println!("mirror check  {line}");
         }
     }
     match &json[..] {

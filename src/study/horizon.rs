@@ -286,12 +286,8 @@ fn table(s: &HorizonStudy) -> String {
     }
     for e in &s.runs {
         t += &format!("{}: {}\n", e.label(), e.verdict);
-        for check in &e.mirror_check {
-            t += &format!(
-                "{}: mirror check {}\n",
-                e.label(),
-                extrapolation::mirror_check_words(check)
-            );
+        for line in extrapolation::mirror_check_lines(&e.mirror_check) {
+            t += &format!("{}: mirror check {line}\n", e.label());
         }
     }
     if let Some(best) = s
