@@ -79,7 +79,8 @@ pub fn start_image(start: &Snapshot, symmetry: Symmetry) -> Cow<'_, Snapshot> {
         Symmetry::None => Cow::Borrowed(start),
         Symmetry::AxialMirror => {
             let mut image = start.clone();
-            symmetry.image_of(true, &mut image.pos, &mut image.vel);
+            symmetry.copy_image(true, &start.pos, &mut image.pos);
+            symmetry.copy_image(true, &start.vel, &mut image.vel);
             Cow::Owned(image)
         }
     }

@@ -409,11 +409,9 @@ pub fn extrapolate_recording(
         scratch.flush(&mut temps);
         if (p, mirrored) != positions_of {
             let end = &snaps[p as usize];
-            out.pos.copy_from_slice(&end.pos);
-            out.vel.copy_from_slice(&end.vel);
-            request
-                .symmetry
-                .image_of(mirrored, &mut out.pos, &mut out.vel);
+            let symmetry = request.symmetry;
+            symmetry.copy_image(mirrored, &end.pos, &mut out.pos);
+            symmetry.copy_image(mirrored, &end.vel, &mut out.vel);
             positions_of = (p, mirrored);
         }
         out.index = k + 1;

@@ -63,12 +63,15 @@ impl Symmetry {
         *self == Symmetry::None
     }
 
-    /// `pos` and `vel` as the period's image: unchanged, or with `y` negated.
-    pub fn image_of(self, mirrored: bool, pos: &mut [[f64; 3]], vel: &mut [[f64; 3]]) {
+    /// `to` set to the image of the vectors `from` (positions or velocities) in a period
+    /// entered `mirrored` or not: a copy, or with `y` negated, in one pass.
+    pub fn copy_image(self, mirrored: bool, from: &[[f64; 3]], to: &mut [[f64; 3]]) {
         if self == Symmetry::AxialMirror && mirrored {
-            for p in pos.iter_mut().chain(vel.iter_mut()) {
-                p[1] = -p[1];
+            for (to, &[x, y, z]) in to.iter_mut().zip(from) {
+                *to = [x, -y, z];
             }
+        } else {
+            to.copy_from_slice(from);
         }
     }
 }
@@ -388,5 +391,23 @@ impl ExtrapolationReader {
             }
         }
         Ok(snap)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Symmetry;
+
+    #[test]
+    fn the_mirror_image_negates_y_and_nothing_else() {
+        let from = [[1.0, 2.0, 3.0], [-4.0, -5.0, 6.0]];
+        let mut to = [[0.0; 3]; 2];
+        Symmetry::AxialMirror.copy_image(true, &from, &mut to);
+        assert_eq!(to, [[1.0, -2.0, 3.0], [-4.0, 5.0, 6.0]]);
+        // a period entered without the mirror, or no symmetry at all: a copy
+        for (symmetry, mirrored) in [(Symmetry::AxialMirror, false), (Symmetry::None, true)] {
+            symmetry.copy_image(mirrored, &from, &mut to);
+            assert_eq!(to, from);
+        }
     }
 }
