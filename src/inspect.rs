@@ -211,6 +211,9 @@ struct ExtrapolationInspection {
     roles: tdex_format::extrapolation::Roles,
     /// `none` or `axial_mirror`: the drum's symmetry the jumps used.
     symmetry: tdex_format::extrapolation::Symmetry,
+    /// With the mirror: each start's mirrored pairing beside its plain one, as stored.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    mirror_check: Vec<tdex_format::extrapolation::MirrorCheck>,
     /// Σ m c T (J) over the particles at the first snapshot (`t1`) and at the last, with
     /// `m c = density · heat_capacity · (4/3)π r³` of the recording's material.
     total_heat_start: f64,
@@ -563,6 +566,7 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         // the pairing's keys in the order the file holds them (sorted)
         roles: info.roles.clone(),
         symmetry: info.symmetry,
+        mirror_check: info.mirror_check.clone(),
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,
@@ -629,6 +633,9 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
     }
     if let Some(words) = crate::extrapolation::symmetry_words(s.symmetry) {
         println!("symmetry      {words}");
+    }
+    for line in crate::extrapolation::mirror_check_lines(&s.mirror_check) {
+        println!("mirror check  {line}");
     }
     println!(
         "heat          Σ m c T {:.6e} J at the start, {:.6e} J at the end (relative change {:.2e})",

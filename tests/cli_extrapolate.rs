@@ -308,14 +308,35 @@ fn the_mirror_is_stated_stored_apart_and_the_same_bytes_on_any_thread_count() {
     assert!(dir.path().join("run.mcap.pairing.json").exists());
     let inspected = tdex_ok(&["inspect", m.to_str().unwrap()]);
     assert!(
-        inspected.contains("t1 to the mirror image of t0") && inspected.contains("axial mirror"),
+        inspected.contains("t1 to the mirror image of t0")
+            && inspected.contains("axial mirror")
+            && inspected.contains("mirror check  t1 to t0: mean distance"),
         "{inspected}"
     );
+    // the check is stored with the extrapolation: inspect and the report state it
+    let stored: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["inspect", m.to_str().unwrap(), "--json"])).unwrap();
+    assert!(
+        stored["mirror_check"][0]["mirrored_mean_diameters"].as_f64() > Some(0.0),
+        "{stored}"
+    );
+    let report = dir.path().join("report");
+    tdex_ok(&[
+        "report",
+        run.to_str().unwrap(),
+        m.to_str().unwrap(),
+        "-o",
+        report.to_str().unwrap(),
+    ]);
+    let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+    assert!(md.contains("Mirror check"), "{md}");
     // without the flag: no symmetry, no check
     let plain = dir.path().join("p.mcap");
     let report = json_of(&extrapolate(&run, &plain, &[]));
     assert_eq!(report["symmetry"], "none");
     assert!(report.get("mirror_check").is_none());
+    let stored = tdex_ok(&["inspect", plain.to_str().unwrap(), "--json"]);
+    assert!(!stored.contains("mirror_check"), "{stored}");
     let paired = tdex_ok(&["pair", run.to_str().unwrap(), "--mirror"]);
     assert!(
         paired.contains("mirror image  ") && paired.contains("mirror check  t1 to t0"),

@@ -92,24 +92,8 @@ pub struct ExtrapolationOutcome {
     pub total_heat_end: f64,
 }
 
-/// How far the axial mirror's pairing of `t_end` to the mirrored `t_start` moves the
-/// particles, beside the plain pairing of the same snapshots: a bed that is its own mirror
-/// image gives about the same mean distance; a bed that leans along the axis a longer one,
-/// and the mirror's jumps then move heat along the axis.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct MirrorCheck {
-    pub end: u32,
-    pub start: u32,
-    pub plain_mean_diameters: f64,
-    pub mirrored_mean_diameters: f64,
-}
-
-impl MirrorCheck {
-    /// The mirrored pairing's mean distance over the plain one's.
-    pub fn ratio(&self) -> f64 {
-        self.mirrored_mean_diameters / self.plain_mean_diameters.max(f64::MIN_POSITIVE)
-    }
-}
+// the mirror check is stored in the extrapolation's info: its type is the format's
+pub use tdex_format::extrapolation::MirrorCheck;
 
 /// A pairing the path needs: of the end snapshot `t_P'` to the start of recorded period
 /// `period` (snapshot `t_{period − 1}`).
@@ -350,6 +334,7 @@ pub fn extrapolate_recording(
         periods: request.periods,
         roles: path_of(&summary_of),
         symmetry: request.symmetry,
+        mirror_check: mirror_check.clone(),
     };
     let mut writer = ExtrapolationWriter::create(&request.output, &out_info)?;
     writer.write_snapshot(&snaps[1])?;

@@ -408,6 +408,14 @@ pub fn document(inp: &Inputs) -> Document {
             pairing_row,
         ]
         .into_iter()
+        // with the mirror, whether the bed was its own mirror image: how far to trust it
+        .chain((!inp.extrapolation.mirror_check.is_empty()).then(|| {
+            row(
+                "Mirror check",
+                crate::extrapolation::mirror_check_lines(&inp.extrapolation.mirror_check)
+                    .join("; "),
+            )
+        }))
         .chain(c.map(|c| row("Voronoi cells", format!("{} (seed {})", c.cells, c.seed))))
         .chain(p.lacey_cells.map(|n| {
             row(

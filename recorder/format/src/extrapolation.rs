@@ -35,6 +35,29 @@ pub struct ExtrapolationInfo {
     /// The drum's symmetry the replay used; absent (the files before it) for none.
     #[serde(default, skip_serializing_if = "Symmetry::is_none")]
     pub symmetry: Symmetry,
+    /// With the axial mirror, each start's mirrored pairing beside its plain one: how far
+    /// the trust in the mirror goes. Absent without the mirror (and in the files before it).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mirror_check: Vec<MirrorCheck>,
+}
+
+/// How far the axial mirror's pairing of `t_end` to the mirrored `t_start` moves the
+/// particles, beside the plain pairing of the same snapshots: a bed that is its own mirror
+/// image gives about the same mean distance; a bed that leans along the axis a longer one,
+/// and the mirror's jumps then move heat along the axis.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MirrorCheck {
+    pub end: u32,
+    pub start: u32,
+    pub plain_mean_diameters: f64,
+    pub mirrored_mean_diameters: f64,
+}
+
+impl MirrorCheck {
+    /// The mirrored pairing's mean distance over the plain one's.
+    pub fn ratio(&self) -> f64 {
+        self.mirrored_mean_diameters / self.plain_mean_diameters.max(f64::MIN_POSITIVE)
+    }
 }
 
 /// A symmetry of the drum an extrapolation uses to vary the periods it replays.
