@@ -41,14 +41,13 @@ pub fn run(plan: &PairPlan) -> Result<()> {
         let plain = pair(plan, &reader, &start, &end, Symmetry::None)?;
         let mirror = if plan.mirror {
             let mirrored = pair(plan, &reader, &start, &end, Symmetry::AxialMirror)?;
-            let check = MirrorCheck {
-                end: end.index,
-                start: start.index,
-                plain_mean_diameters: plain.measured.mean_distance_diameters,
-                mirrored_mean_diameters: mirrored.measured.mean_distance_diameters,
-            };
-            checks.push(check);
-            Some((mirrored, check))
+            checks.push(MirrorCheck::of(
+                end.index,
+                start.index,
+                &plain.measured,
+                &mirrored.measured,
+            ));
+            Some(mirrored)
         } else {
             None
         };
@@ -58,7 +57,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
                 one["end"] = end.index.into();
                 one["start"] = start.index.into();
             }
-            if let Some((mirrored, check)) = &mirror {
+            if let (Some(mirrored), Some(check)) = (&mirror, checks.last()) {
                 one["mirror"] = as_json(mirrored)?;
                 one["mirror_check"] = serde_json::to_value(check)?;
             }
@@ -69,7 +68,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
             println!("t{} to t{}", end.index, start.index);
         }
         tell(&plain, "pairing");
-        if let Some((mirrored, _)) = &mirror {
+        if let Some(mirrored) = &mirror {
             tell(mirrored, "mirror image");
         }
     }

@@ -327,6 +327,20 @@ fn bad_study_flags_exit_2_naming_the_flag() {
 /// P replayed over the same reference periods and judged against the same DEM runs; the
 /// recording cost grows with P; the same study from the recording itself gives the same
 /// verdicts; flags that shape a recording are refused with a recording.
+/// `tdex study horizon REC --recorded-periods 1,2 FLAGS --json -o OUT`, its JSON.
+fn horizon_from_recording(rec: &Path, flags: &[&str], out: &Path) -> serde_json::Value {
+    let mut args = vec![
+        "study",
+        "horizon",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "1,2",
+    ];
+    args.extend(flags);
+    args.extend(["--json", "-o", out.to_str().unwrap()]);
+    serde_json::from_str(&ok(&args)).unwrap()
+}
+
 #[test]
 fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     let dir = tempfile::tempdir().unwrap();
@@ -379,17 +393,7 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     // from the recording: the same DEM runs, the same paths, the same judgement
     let rec = out.join("horizon.mcap");
     let again = dir.path().join("again");
-    let json2 = ok(&[
-        "study",
-        "horizon",
-        rec.to_str().unwrap(),
-        "--recorded-periods",
-        "1,2",
-        "--json",
-        "-o",
-        again.to_str().unwrap(),
-    ]);
-    let study2: serde_json::Value = serde_json::from_str(&json2).unwrap();
+    let study2 = horizon_from_recording(&rec, &[], &again);
     for (a, b) in runs.iter().zip(study2["runs"].as_array().unwrap()) {
         assert_eq!(a["median_ratio"], b["median_ratio"]);
         assert_eq!(a["outside_range"], b["outside_range"]);
@@ -398,18 +402,7 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     // with --mirror every P runs twice, the paper's method first (the same figures as
     // without the flag) and then the mirror image, with its check; each has its own file
     let mirrored = dir.path().join("mirrored");
-    let json3 = ok(&[
-        "study",
-        "horizon",
-        rec.to_str().unwrap(),
-        "--recorded-periods",
-        "1,2",
-        "--mirror",
-        "--json",
-        "-o",
-        mirrored.to_str().unwrap(),
-    ]);
-    let study3: serde_json::Value = serde_json::from_str(&json3).unwrap();
+    let study3 = horizon_from_recording(&rec, &["--mirror"], &mirrored);
     let runs3 = study3["runs"].as_array().unwrap();
     let shape: Vec<(u64, &str)> = runs3
         .iter()

@@ -249,12 +249,12 @@ pub fn extrapolate_recording(
                 Some(stored) => stored,
                 None => compute_and_store(start, end, Symmetry::None)?,
             };
-            mirror_check.push(MirrorCheck {
-                end: used,
-                start: p.period - 1,
-                plain_mean_diameters: plain.summary.mean_distance_diameters,
-                mirrored_mean_diameters: p.stored.summary.mean_distance_diameters,
-            });
+            mirror_check.push(MirrorCheck::of(
+                used,
+                p.period - 1,
+                &plain.summary,
+                &p.stored.summary,
+            ));
         }
     }
     let pairing_of = |period: u32| {

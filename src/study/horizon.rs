@@ -202,20 +202,6 @@ impl Entry {
         }
     }
 
-    /// One colour per P, the mirror's line dashed in its P's colour.
-    fn line_kind(&self, runs: &[Entry]) -> LineKind {
-        let mut ps: Vec<u32> = runs.iter().map(|e| e.recorded_periods).collect();
-        ps.dedup();
-        let n = ps
-            .iter()
-            .position(|&p| p == self.recorded_periods)
-            .unwrap_or(0);
-        match self.symmetry {
-            Symmetry::None => LineKind::Extrapolation(n),
-            Symmetry::AxialMirror => LineKind::MirroredExtrapolation(n),
-        }
-    }
-
     fn new(
         p: u32,
         symmetry: Symmetry,
@@ -332,12 +318,33 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
     )
 }
 
+/// Each run's line: one colour per P (in the order the runs come), the mirror's line
+/// dashed in its P's colour.
+fn line_kinds(runs: &[Entry]) -> Vec<LineKind> {
+    let mut colour = 0;
+    let mut last_p = None;
+    runs.iter()
+        .map(|e| {
+            if last_p.is_some_and(|p| p != e.recorded_periods) {
+                colour += 1;
+            }
+            last_p = Some(e.recorded_periods);
+            match e.symmetry {
+                Symmetry::None => LineKind::Extrapolation(colour),
+                Symmetry::AxialMirror => LineKind::MirroredExtrapolation(colour),
+            }
+        })
+        .collect()
+}
+
 fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
+    let kinds = line_kinds(&s.runs);
     let ratio_lines: Vec<Line> = s
         .runs
         .iter()
-        .map(|e| Line {
-            kind: e.line_kind(&s.runs),
+        .zip(&kinds)
+        .map(|(e, &kind)| Line {
+            kind,
             label: e.label(),
             points: e
                 .comparison
@@ -388,7 +395,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             push_means(format!("DEM twin {}", m + 1), LineKind::DemRun, twin);
         }
     }
-    for e in &s.runs {
+    for (e, &kind) in s.runs.iter().zip(&kinds) {
         let extrapolated: Vec<GroupMeans> = e
             .comparison
             .periods
@@ -401,11 +408,7 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
                 bed: p.bed_mean_extra,
             })
             .collect();
-        push_means(
-            format!("extrapolated, {}", e.label()),
-            e.line_kind(&s.runs),
-            &extrapolated,
-        );
+        push_means(format!("extrapolated, {}", e.label()), kind, &extrapolated);
     }
     let means = plots::lines(
         if groups {

@@ -54,6 +54,22 @@ pub struct MirrorCheck {
 }
 
 impl MirrorCheck {
+    /// The check of `t_end` paired to `t_start` plainly and to its mirror image, from the
+    /// two pairings' summaries.
+    pub fn of(
+        end: u32,
+        start: u32,
+        plain: &super::sidecar::PairingSummary,
+        mirrored: &super::sidecar::PairingSummary,
+    ) -> Self {
+        Self {
+            end,
+            start,
+            plain_mean_diameters: plain.mean_distance_diameters,
+            mirrored_mean_diameters: mirrored.mean_distance_diameters,
+        }
+    }
+
     /// The mirrored pairing's mean distance over the plain one's.
     pub fn ratio(&self) -> f64 {
         self.mirrored_mean_diameters / self.plain_mean_diameters.max(f64::MIN_POSITIVE)
