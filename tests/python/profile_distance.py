@@ -3,7 +3,7 @@
 more than the DEM runs' profiles depart from each other? (diagnostic, docs/validation.md,
 "Where the pilot drum's excess is")
 
-usage: profile_distance.py RECORDING.mcap BIN_D EXTRA.mcap [EXTRA.mcap ...]
+usage: profile_distance.py [--each] RECORDING.mcap BIN_D EXTRA.mcap [EXTRA.mcap ...]
        (RECORDING made with --reference K --twins M; the drum's axis is y; BIN_D: the bins'
        width in particle diameters)
 
@@ -15,7 +15,8 @@ difference (K). Printed per direction: each extrapolation's mean distance to the
 over the DEM pairs' mean distance, the median over the t_k. A ratio well above 1 along one
 direction says the replay's large-scale pattern departs from the DEM's along it. A recording
 without twins gives, per t_k, each extrapolation's distance to the reference and the
-reference profile's own rms about the bed mean, to set beside them.
+reference profile's own rms about the bed mean, to set beside them. `--each` also prints,
+per direction and t_k, the DEM pairs' mean distance and each extrapolation's ratio.
 """
 import sys
 
@@ -58,7 +59,7 @@ def rms_about_mean(points, direction, width):
     return float(np.sqrt(np.average(dev**2, weights=w)))
 
 
-def main(rec_path, bin_d, extra_paths):
+def main(rec_path, bin_d, extra_paths, each=False):
     rec = by_topic(rec_path)
     dem = rec["/tdex/snapshots"]
     twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
@@ -96,11 +97,19 @@ def main(rec_path, bin_d, extra_paths):
             ratios.append(
                 [np.mean([distance(r, e[k], direction, width) for r in runs]) / pairs for e in extras]
             )
+            if each:
+                print(
+                    f"  {direction} t{k}: DEM pairs {pairs:.4f} K, ratio "
+                    + " ".join(f"{x:.2f}" for x in ratios[-1])
+                )
         medians = np.median(ratios, axis=0)
         print(f"{direction:<9}  " + "  ".join(f"{m:.3f}" for m in medians))
 
 
 if __name__ == "__main__":
-    if len(sys.argv) < 4:
+    args = sys.argv[1:]
+    each = "--each" in args
+    args = [a for a in args if a != "--each"]
+    if len(args) < 3:
         sys.exit(__doc__)
-    main(sys.argv[1], float(sys.argv[2]), sys.argv[3:])
+    main(args[0], float(args[1]), args[2:], each)
