@@ -11,9 +11,12 @@ particles that start it in each axial bin: the revolution's axial transport fiel
 the fields' mean over the revolutions (the systematic transport, which every revolution
 repeats: near the end caps particles can only move inwards), the rms of each revolution's
 field about that mean (its own, random part), and the recorded revolution's field beside the
-mean. The replay repeats the recorded revolution's random part at every period, where the
-DEM draws a new one each revolution: a random part that is small against the bins says the
-replay cannot build an axial pattern from it in a few periods.
+mean, and the recorded revolution's random part split into its halves even and odd in y
+(bins mirrored about the mid-plane y = 0). The replay repeats the recorded revolution's
+random part at every period, where the DEM draws a new one each revolution: a random part
+that is small against the bins says the replay cannot build an axial pattern from it in a
+few periods. With `--mirror` a period and its mirror image move the particles at y by
+Δ(y) − Δ(−y): the even half cancels, the odd half adds up as without the mirror.
 """
 import sys
 
@@ -48,6 +51,15 @@ def main(rec_path, bin_d):
     print(f"systematic transport: rms {np.sqrt((systematic ** 2).mean()):.3f} d over the bins")
     print("random part, rms per revolution (d): " + " ".join(f"{x:.3f}" for x in random))
     print(f"  the recorded revolution's: {random[0]:.3f} d; the others' median {np.median(random[1:]):.3f} d")
+    index = {k: i for i, k in enumerate(common)}
+    pairs = [(i, index[-k - 1]) for i, k in enumerate(common) if -k - 1 in index]
+    recorded = per_revolution[0] - systematic
+    even = np.array([0.5 * (recorded[i] + recorded[j]) for i, j in pairs])
+    odd = np.array([0.5 * (recorded[i] - recorded[j]) for i, j in pairs])
+    print(
+        f"  its halves even and odd in y: {np.sqrt((even ** 2).mean()):.3f} d and "
+        f"{np.sqrt((odd ** 2).mean()):.3f} d"
+    )
     print("the recorded revolution's field (d): " + " ".join(f"{x:+.2f}" for x in per_revolution[0]))
     print("the mean field (d):                  " + " ".join(f"{x:+.2f}" for x in systematic))
 
