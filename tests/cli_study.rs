@@ -323,10 +323,6 @@ fn bad_study_flags_exit_2_naming_the_flag() {
     );
 }
 
-/// The horizon study on the tiny drum: one DEM run recording two periods with a twin, both
-/// P replayed over the same reference periods and judged against the same DEM runs; the
-/// recording cost grows with P; the same study from the recording itself gives the same
-/// verdicts; flags that shape a recording are refused with a recording.
 /// `tdex study horizon REC --recorded-periods 1,2 FLAGS --json -o OUT`, its JSON.
 fn horizon_from_recording(rec: &Path, flags: &[&str], out: &Path) -> serde_json::Value {
     let mut args = vec![
@@ -341,6 +337,10 @@ fn horizon_from_recording(rec: &Path, flags: &[&str], out: &Path) -> serde_json:
     serde_json::from_str(&ok(&args)).unwrap()
 }
 
+/// The horizon study on the tiny drum: one DEM run recording two periods with a twin, both
+/// P replayed over the same reference periods and judged against the same DEM runs; the
+/// recording cost grows with P; the same study from the recording itself gives the same
+/// verdicts; flags that shape a recording are refused with a recording.
 #[test]
 fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     let dir = tempfile::tempdir().unwrap();

@@ -27,7 +27,8 @@ from spread import by_topic
 SHIFTS = [np.array([0.37, 0.53, 0.71]) * o / 4 for o in range(4)]
 
 
-def cell_means(points, edge, shift):
+def cell_keys(points, edge, shift):
+    """Each particle's cubic cell of the given edge, the grid shifted by `shift` cells."""
     xyz = np.stack([points["x"], points["y"], points["z"]]).T
     return np.floor(xyz / edge - shift).astype(np.int64)
 
@@ -43,8 +44,8 @@ def distance(a, b, edge):
     """Particle-weighted mean |ΔT| of the cell means, and each field's std, over SHIFTS."""
     dists, stds = [], []
     for shift in SHIFTS:
-        fa = field(a, cell_means(a, edge, shift))
-        fb = field(b, cell_means(b, edge, shift))
+        fa = field(a, cell_keys(a, edge, shift))
+        fb = field(b, cell_keys(b, edge, shift))
         floor = 0.5 * np.median([c for _, c in fa.values()])
         common = [k for k, (_, c) in fa.items() if c >= floor and k in fb]
         w = np.array([fa[k][1] for k in common], dtype=float)
@@ -65,10 +66,7 @@ def main(rec_path, extra_path, edges_d):
     dem = rec["/tdex/snapshots"]
     twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
     ex = extra["/tdex/snapshots"]
-    first = dem[min(dem)]
-    d = 2.0 * float(np.median(first["r"])) if "r" in first.dtype.names else None
-    if d is None:
-        sys.exit("the snapshots carry no radius: cannot express cells in diameters")
+    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
     ks = sorted(k for k in ex if k in dem and k >= 2)
     print(f"cells in particle diameters (d = {d * 1e3:g} mm); distances in K")
     for edge_d in edges_d:
