@@ -39,15 +39,13 @@ pub fn run(plan: &PairPlan) -> Result<()> {
     for start in 0..last {
         let start = snapshot(&reader, start)?;
         let plain = pair(plan, &reader, &start, &end, Symmetry::None)?;
+        // the mirror pairing and its check travel together: the check is of this start
         let mirror = if plan.mirror {
             let mirrored = pair(plan, &reader, &start, &end, Symmetry::AxialMirror)?;
-            checks.push(MirrorCheck::of(
-                end.index,
-                start.index,
-                &plain.measured,
-                &mirrored.measured,
-            ));
-            Some(mirrored)
+            let check =
+                MirrorCheck::of(end.index, start.index, &plain.measured, &mirrored.measured);
+            checks.push(check);
+            Some((mirrored, check))
         } else {
             None
         };
@@ -57,7 +55,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
                 one["end"] = end.index.into();
                 one["start"] = start.index.into();
             }
-            if let (Some(mirrored), Some(check)) = (&mirror, checks.last()) {
+            if let Some((mirrored, check)) = &mirror {
                 one["mirror"] = as_json(mirrored)?;
                 one["mirror_check"] = serde_json::to_value(check)?;
             }
@@ -68,7 +66,7 @@ pub fn run(plan: &PairPlan) -> Result<()> {
             println!("t{} to t{}", end.index, start.index);
         }
         tell(&plain, "pairing");
-        if let Some(mirrored) = &mirror {
+        if let Some((mirrored, _)) = &mirror {
             tell(mirrored, "mirror image");
         }
     }

@@ -14,12 +14,11 @@ import sys
 import numpy as np
 
 from period_map import snapshots
+from spread import by_id
 
 
 def axial_by_id(snap):
-    y = np.empty(len(snap))
-    y[snap["id"]] = snap["y"]
-    return y
+    return by_id(snap, "y")
 
 
 def main(recording, extrapolation):

@@ -22,13 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
-
-
-def by_id(points, field):
-    out = np.empty(len(points))
-    out[points["id"]] = points[field]
-    return out
+from spread import by_id, by_topic
 
 
 def main(rec_path, bin_d):

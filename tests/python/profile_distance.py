@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
+from spread import by_topic, well_filled
 
 DIRECTIONS = ["x", "y", "z", "depth"]
 
@@ -43,8 +43,7 @@ def profile(points, direction, width):
 
 def distance(a, b, direction, width):
     pa, pb = profile(a, direction, width), profile(b, direction, width)
-    floor = 0.5 * np.median([c for _, c in pa.values()])
-    keys = [k for k, (_, c) in pa.items() if c >= floor and k in pb]
+    keys = [k for k in well_filled(pa) if k in pb]
     w = np.array([pa[k][1] for k in keys], dtype=float)
     diff = np.array([pa[k][0] - pb[k][0] for k in keys])
     return float(np.sqrt(np.average(diff**2, weights=w)))
@@ -52,8 +51,7 @@ def distance(a, b, direction, width):
 
 def rms_about_mean(points, direction, width):
     bins = profile(points, direction, width)
-    floor = 0.5 * np.median([c for _, c in bins.values()])
-    kept = [(m, c) for m, c in bins.values() if c >= floor]
+    kept = [bins[k] for k in well_filled(bins)]
     w = np.array([c for _, c in kept], dtype=float)
     dev = np.array([m for m, _ in kept]) - points["T"].mean()
     return float(np.sqrt(np.average(dev**2, weights=w)))

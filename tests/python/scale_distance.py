@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
+from spread import by_topic, well_filled
 
 SHIFTS = [np.array([0.37, 0.53, 0.71]) * o / 4 for o in range(4)]
 
@@ -46,8 +46,7 @@ def distance(a, b, edge):
     for shift in SHIFTS:
         fa = field(a, cell_keys(a, edge, shift))
         fb = field(b, cell_keys(b, edge, shift))
-        floor = 0.5 * np.median([c for _, c in fa.values()])
-        common = [k for k, (_, c) in fa.items() if c >= floor and k in fb]
+        common = [k for k in well_filled(fa) if k in fb]
         w = np.array([fa[k][1] for k in common], dtype=float)
         ta = np.array([fa[k][0] for k in common])
         tb = np.array([fb[k][0] for k in common])

@@ -16,13 +16,11 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
+from spread import by_id, by_topic
 
 
 def positions(points):
-    out = np.empty((len(points), 3))
-    out[points["id"]] = np.stack([points["x"], points["y"], points["z"]]).T
-    return out
+    return by_id(points, "x", "y", "z")
 
 
 def main(rec_path, extra_path):

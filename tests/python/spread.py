@@ -28,6 +28,20 @@ def by_topic(path):
     return out
 
 
+def by_id(points, *fields):
+    """The named fields in particle-id order: a vector for one field, one column per field."""
+    out = np.empty((len(points), len(fields)))
+    out[points["id"]] = np.stack([points[f] for f in fields]).T
+    return out[:, 0] if len(fields) == 1 else out
+
+
+def well_filled(cells):
+    """The keys of a {key: (mean, count)} map whose cells hold at least half the median count:
+    the thin cells at the bed's surface and walls are mostly sampling noise."""
+    floor = 0.5 * np.median([c for _, c in cells.values()])
+    return [k for k, (_, c) in cells.items() if c >= floor]
+
+
 def main(recording, extra):
     runs = by_topic(recording)
     dem = runs.pop("/tdex/snapshots")
