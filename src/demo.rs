@@ -5,8 +5,7 @@
 use crate::cli::{DemoPlan, RecordPlan, RecordStart, SamplingFlags, Tau};
 use crate::{compare, extrapolation, record, report};
 use anyhow::Result;
-use extrapolate::replay::Scheme;
-use extrapolate::{ExtrapolationRequest, TableChoice};
+use extrapolate::ExtrapolationRequest;
 use tdex_format::{AreaEncoding, ExtrapolationReader, RecordingReader};
 
 /// The built-in case (the same text as `cases/small_drum.toml`).
@@ -60,19 +59,12 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
     })?;
 
     println!("2/4 extrapolate {PERIODS} periods (pairing, then the explicit replay)");
-    let request = ExtrapolationRequest {
-        recording: recording.clone(),
-        periods: PERIODS,
-        output: extra.clone(),
-        scheme: Scheme::Explicit,
-        table: TableChoice::InMemoryIfItFits,
-        memory_limit: extrapolation::memory_limit(None),
-        reproducible: false,
-        recorded_periods: None,
-        path_seed: None,
-        jump_targets: None,
-        symmetry: tdex_format::extrapolation::Symmetry::None,
-    };
+    let request = ExtrapolationRequest::new(
+        recording.clone(),
+        PERIODS,
+        extra.clone(),
+        extrapolation::memory_limit(None),
+    );
     let outcome = crate::with_workers(plan.threads, || {
         Ok(extrapolate::extrapolate_recording(
             &request,

@@ -48,6 +48,32 @@ pub struct ExtrapolationRequest {
     pub symmetry: Symmetry,
 }
 
+impl ExtrapolationRequest {
+    /// The paper's method on every recorded period: the explicit scheme, the table in memory
+    /// when it fits the limit, the case's path seed, every start a jump target, no
+    /// symmetry, times kept. Callers change what they need with struct update syntax.
+    pub fn new(
+        recording: PathBuf,
+        periods: u32,
+        output: PathBuf,
+        memory_limit: MemoryLimit,
+    ) -> Self {
+        Self {
+            recording,
+            periods,
+            output,
+            scheme: Scheme::Explicit,
+            table: TableChoice::InMemoryIfItFits,
+            memory_limit,
+            reproducible: false,
+            recorded_periods: None,
+            path_seed: None,
+            jump_targets: None,
+            symmetry: Symmetry::None,
+        }
+    }
+}
+
 /// Where the replay keeps the collision table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TableChoice {

@@ -165,20 +165,16 @@ impl Synthetic {
 
 fn request(recording: &Path, output: &Path, periods: u32) -> ExtrapolationRequest {
     ExtrapolationRequest {
-        recording: recording.to_path_buf(),
-        periods,
-        output: output.to_path_buf(),
-        scheme: Scheme::Explicit,
-        table: TableChoice::InMemoryIfItFits,
-        memory_limit: MemoryLimit {
-            bytes: u64::MAX,
-            source: "test".into(),
-        },
         reproducible: true,
-        recorded_periods: None,
-        path_seed: None,
-        jump_targets: None,
-        symmetry: tdex_format::extrapolation::Symmetry::None,
+        ..ExtrapolationRequest::new(
+            recording.to_path_buf(),
+            periods,
+            output.to_path_buf(),
+            MemoryLimit {
+                bytes: u64::MAX,
+                source: "test".into(),
+            },
+        )
     }
 }
 

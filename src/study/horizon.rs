@@ -13,8 +13,7 @@ use crate::cli::{HorizonSource, StudyPlan};
 use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
-use extrapolate::replay::Scheme;
-use extrapolate::{ExtrapolationRequest, MirrorCheck, TableChoice};
+use extrapolate::{ExtrapolationRequest, MirrorCheck};
 use recorder::record;
 use serde::Serialize;
 use std::path::Path;
@@ -126,17 +125,15 @@ pub fn run(
             Symmetry::AxialMirror => format!("horizon_p{p}_mirror.extra.mcap"),
         });
         let request = ExtrapolationRequest {
-            recording: recording.clone(),
-            periods: info.reference_periods,
-            output: extra.clone(),
-            scheme: Scheme::Explicit,
-            table: TableChoice::InMemoryIfItFits,
-            memory_limit: extrapolation::memory_limit(None),
-            reproducible: false,
             recorded_periods: Some(p),
             path_seed: seed,
-            jump_targets: None,
             symmetry,
+            ..ExtrapolationRequest::new(
+                recording.clone(),
+                info.reference_periods,
+                extra.clone(),
+                extrapolation::memory_limit(None),
+            )
         };
         let outcome = crate::with_workers(plan.threads, || {
             Ok(extrapolate::extrapolate_recording(

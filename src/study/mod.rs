@@ -13,8 +13,7 @@ use crate::cli::{StudyKind, StudyPlan};
 use crate::compare::{self, Comparison};
 use crate::extrapolation;
 use anyhow::Result;
-use extrapolate::replay::Scheme;
-use extrapolate::{ExtrapolationRequest, TableChoice};
+use extrapolate::ExtrapolationRequest;
 // the study's speedups are the report's (Table 6 form)
 use crate::report::costs::{CostTable, TABLE_PERIODS};
 use serde::Serialize;
@@ -106,19 +105,12 @@ pub fn evaluate(
     cells: usize,
 ) -> Result<Outcome> {
     let rec = RecordingReader::open(recording)?;
-    let request = ExtrapolationRequest {
-        recording: recording.to_path_buf(),
+    let request = ExtrapolationRequest::new(
+        recording.to_path_buf(),
         periods,
-        output: extra.to_path_buf(),
-        scheme: Scheme::Explicit,
-        table: TableChoice::InMemoryIfItFits,
-        memory_limit: extrapolation::memory_limit(None),
-        reproducible: false,
-        recorded_periods: None,
-        path_seed: None,
-        jump_targets: None,
-        symmetry: tdex_format::extrapolation::Symmetry::None,
-    };
+        extra.to_path_buf(),
+        extrapolation::memory_limit(None),
+    );
     if let Err(e) = crate::with_workers(threads, || {
         Ok(extrapolate::extrapolate_recording(
             &request,
