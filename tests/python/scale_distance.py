@@ -70,7 +70,7 @@ def main(rec_path, extra_path, edges_d):
     print(f"cells in particle diameters (d = {d * 1e3:g} mm); distances in K")
     for edge_d in edges_d:
         print(f"cell edge {edge_d:g} d:")
-        ratios = []
+        ratios = {}
         for k in ks:
             runs = [dem[k]] + [t[k] for t in twins if k in t]
             pairs = [
@@ -89,13 +89,15 @@ def main(rec_path, extra_path, edges_d):
             )
             if pairs:
                 ratio = np.mean(to_runs) / np.mean(pairs)
-                ratios.append(ratio)
+                ratios[k] = ratio
                 line += " | DEM pairs " + " ".join(f"{x:.4f}" for x in pairs)
                 line += f" | ratio {ratio:.3f}"
             line += f" | field std reference {std_ref:.4f}, extrapolation {std_ex:.4f}"
             print(line)
         if ratios:
-            print(f"  median ratio over t{ks[0]}…t{ks[-1]}: {np.median(ratios):.3f}")
+            # over the t_k a twin holds (a recording still being written holds fewer)
+            first, last = min(ratios), max(ratios)
+            print(f"  median ratio over t{first}…t{last}: {np.median(list(ratios.values())):.3f}")
 
 
 if __name__ == "__main__":
