@@ -1,0 +1,58 @@
+#!/usr/bin/env python3
+"""Does the hot-cold contrast vary along the axis more in the extrapolation than in the DEM?
+(diagnostic, docs/validation.md, "Where the pilot drum's excess is")
+
+usage: slab_contrast.py RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with --reference
+       K --twins M; the drum's axis is y; SLAB_D: the slabs' width in particle diameters)
+
+The bed is cut into axial slabs; in each, the contrast is the mean temperature of the
+particles hot at t0 less that of those cold at t0 (hot: above the bed mean at t0). Printed
+per t_k: the bed's mean slab contrast, each run's rms of its slab contrasts about their mean
+(how much the contrast varies along the axis), and each run's rms slab difference to the
+reference. Slabs with fewer than half the median count are left out.
+"""
+import sys
+
+import numpy as np
+
+from spread import by_id, by_topic
+
+
+def contrasts(points, hot_by_id, width):
+    """{slab: hot mean − cold mean} over the well-filled slabs."""
+    hot = hot_by_id[points["id"]]
+    slab = np.floor(points["y"] / width).astype(np.int64)
+    keys, counts = np.unique(slab, return_counts=True)
+    floor = 0.5 * np.median(counts)
+    return {
+        b: points["T"][(slab == b) & hot].mean() - points["T"][(slab == b) & ~hot].mean()
+        for b, c in zip(keys, counts)
+        if c >= floor
+    }
+
+
+def main(rec_path, extra_path, slab_d):
+    rec = by_topic(rec_path)
+    dem = rec["/tdex/snapshots"]
+    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    ex = by_topic(extra_path)["/tdex/snapshots"]
+    width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
+    at_t0 = by_id(dem[min(dem)], "T")
+    hot_by_id = at_t0 > at_t0.mean()
+    names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
+    print(f"slabs of {slab_d:g} diameters; K")
+    for k in (k for k in sorted(dem) if k >= 2 and k in ex and all(k in t for t in twins)):
+        runs = [contrasts(r[k], hot_by_id, width) for r in [dem] + twins + [ex]]
+        slabs = sorted(set.intersection(*(set(c) for c in runs)))
+        v = np.array([[c[b] for b in slabs] for c in runs])
+        spread = " ".join(f"{n} {row.std():.3f}" for n, row in zip(names, v))
+        to_ref = " ".join(
+            f"{n} {np.sqrt(np.mean((row - v[0]) ** 2)):.3f}" for n, row in zip(names[1:], v[1:])
+        )
+        print(f"t{k}: mean contrast {v[0].mean():.3f}; along the axis: {spread}; to the reference: {to_ref}")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    main(sys.argv[1], sys.argv[2], float(sys.argv[3]))
