@@ -15,20 +15,21 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic
+from spread import by_id, by_topic, well_filled
 
 
 def contrasts(points, hot_by_id, width):
     """{slab: hot mean − cold mean} over the well-filled slabs."""
     hot = hot_by_id[points["id"]]
     slab = np.floor(points["y"] / width).astype(np.int64)
-    keys, counts = np.unique(slab, return_counts=True)
-    floor = 0.5 * np.median(counts)
-    return {
-        b: points["T"][(slab == b) & hot].mean() - points["T"][(slab == b) & ~hot].mean()
-        for b, c in zip(keys, counts)
-        if c >= floor
-    }
+    keys, index, counts = np.unique(slab, return_inverse=True, return_counts=True)
+    index = index.ravel()
+    n_hot = np.bincount(index, weights=hot)
+    t_hot = np.bincount(index, weights=points["T"] * hot)
+    t_all = np.bincount(index, weights=points["T"])
+    contrast = t_hot / n_hot - (t_all - t_hot) / (counts - n_hot)
+    cells = {b: (c_t, n) for b, c_t, n in zip(keys, contrast, counts)}
+    return {b: cells[b][0] for b in well_filled(cells)}
 
 
 def main(rec_path, extra_path, slab_d):
