@@ -17,7 +17,7 @@ import sys
 import numpy as np
 
 from scale_distance import distance
-from spread import by_topic
+from spread import by_topic, ratios_to_runs
 
 PLANES = [("y", "x-z, whole axis"), ("x", "y-z, whole width"), ("z", "x-y, whole height"), (None, "3-D cells")]
 
@@ -47,12 +47,7 @@ def main(rec_path, extra_path, edge_d):
         for k in ks:
             runs = [flattened(r[k], axis) for r in [dem] + twins]
             e = flattened(ex[k], axis)
-            pairs = [
-                distance(runs[i], runs[j], edge)[0]
-                for i in range(len(runs))
-                for j in range(i + 1, len(runs))
-            ]
-            ratios.append(np.mean([distance(r, e, edge)[0] for r in runs]) / np.mean(pairs))
+            ratios.append(ratios_to_runs(runs, [e], lambda a, b: distance(a, b, edge)[0])[0])
         print(f"{name:<28} " + " ".join(f"{r:<5.2f}" for r in ratios) + f" {np.median(ratios):.2f}")
 
 

@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic, well_filled
+from spread import by_topic, dem_pairs, ratios_to_runs, well_filled
 
 DIRECTIONS = ["x", "y", "z", "depth"]
 
@@ -85,17 +85,12 @@ def main(rec_path, bin_d, extra_paths, each=False):
         ratios = []
         for k in ks:
             runs = [dem[k]] + [t[k] for t in twins]
-            pairs = np.mean(
-                [
-                    distance(runs[i], runs[j], direction, width)
-                    for i in range(len(runs))
-                    for j in range(i + 1, len(runs))
-                ]
-            )
-            ratios.append(
-                [np.mean([distance(r, e[k], direction, width) for r in runs]) / pairs for e in extras]
-            )
+            def along(a, b):
+                return distance(a, b, direction, width)
+
+            ratios.append(ratios_to_runs(runs, [e[k] for e in extras], along))
             if each:
+                pairs = np.mean(dem_pairs(runs, along))
                 print(
                     f"  {direction} t{k}: DEM pairs {pairs:.4f} K, ratio "
                     + " ".join(f"{x:.2f}" for x in ratios[-1])

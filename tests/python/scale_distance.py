@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic, well_filled
+from spread import by_topic, dem_pairs, well_filled
 
 SHIFTS = [np.array([0.37, 0.53, 0.71]) * o / 4 for o in range(4)]
 
@@ -73,11 +73,7 @@ def main(rec_path, extra_path, edges_d):
         ratios = {}
         for k in ks:
             runs = [dem[k]] + [t[k] for t in twins if k in t]
-            pairs = [
-                distance(runs[i], runs[j], edge_d * d)[0]
-                for i in range(len(runs))
-                for j in range(i + 1, len(runs))
-            ]
+            pairs = dem_pairs(runs, lambda a, b: distance(a, b, edge_d * d)[0])
             to_runs = []
             for i, r in enumerate(runs):
                 dist, std = distance(r, ex[k], edge_d * d)

@@ -42,6 +42,19 @@ def well_filled(cells):
     return [k for k, (_, c) in cells.items() if c >= floor]
 
 
+def dem_pairs(runs, distance):
+    """The distance of every pair of DEM runs (reference and twins), each pair once, in order:
+    the yardstick an extrapolation's distance to the runs is measured against."""
+    return [distance(runs[i], runs[j]) for i in range(len(runs)) for j in range(i + 1, len(runs))]
+
+
+def ratios_to_runs(runs, extras, distance):
+    """Per extrapolation, its mean distance to the DEM runs over the DEM pairs' mean distance
+    (`distance(a, b)`, a float; the run first, as its cells choose what is compared)."""
+    pairs = np.mean(dem_pairs(runs, distance))
+    return [float(np.mean([distance(r, e) for r in runs]) / pairs) for e in extras]
+
+
 def main(recording, extra):
     runs = by_topic(recording)
     dem = runs.pop("/tdex/snapshots")
