@@ -20,11 +20,11 @@ fn spread(mut x: u64) -> u64 {
 /// the box `[lo, hi]`. Ties are broken by index, so the order is deterministic.
 ///
 /// The curve's cells are cubes in space: one scale for all three axes, set by the box's
-/// longest side. Scaled per axis, a long bed's cells are needles: on the long kiln (a bed
-/// 635 diameters long, 38 wide, 14 deep) a cell holding two or three particles was 40
-/// diameters long, so a row's 32 nearest columns lay 20 845 indices apart on average and
-/// on 24.6 distinct cache lines of an 8-byte-per-column array; with cubes, 793 indices
-/// and 12.1 lines, and the auction's bids took a quarter less time (docs/benchmarks.md).
+/// longest side. Scaled per axis, a long bed's cells are needles: on the long kiln (a box
+/// of 634 × 35 × 25 diameters) a cell one diameter across was 20 diameters long, so a
+/// row's 32 nearest columns lay 20 845 indices apart on average and on 24.6 distinct
+/// cache lines of an 8-byte-per-column array; with cubes, 793 indices and 12.1 lines,
+/// and the auction's bids took a fifth to a quarter less time (docs/benchmarks.md).
 pub(crate) fn morton_order(pts: &[[f64; 3]], lo: [f64; 3], hi: [f64; 3]) -> Vec<u32> {
     let side = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
     let scale = if side > 0.0 {
