@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Do the axial slabs keep their own mixing rate from one revolution to the next? (diagnostic,
+docs/validation.md, "Where the pilot drum's excess is")
+
+usage: slab_persistence.py [--each] RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with
+       --reference K; the drum's axis is y; SLAB_D: the slabs' width in particle diameters;
+       --each also prints every slab's anomaly per period)
+
+Per axial slab and snapshot, the hot-cold contrast of slab_contrast.py (the mean temperature of
+the particles hot at t0 less that of those cold at t0). Over each period, a slab's decay is the
+log of its contrast at the end over that at the start; less the bed's mean decay over that
+period, it is the slab's anomaly: how much faster or slower than the bed it mixed. Printed, for
+the DEM reference and the extrapolation: the anomalies' rms per period, and the correlation
+across slabs of the anomalies of consecutive periods. The replay applies the recorded
+period's contacts every period, so where a slab's rate is set by its contacts rather than by
+the temperature pattern it holds, the replay's correlations are high. If they are and the
+DEM's are low, each DEM revolution draws its slabs' rates anew and the replay's repetition
+adds up along the axis where the DEM's averages out (the candidate mechanism of the pilot
+drum's excess); if the DEM's are as high, the slabs' rates are a property of the drum (its
+ends, its fill) and the repetition is faithful; if both are low, the slabs' rates follow the
+temperature pattern and this test cannot tell.
+"""
+import sys
+
+import numpy as np
+
+from slab_contrast import contrasts
+from spread import by_id, by_topic
+
+
+def decays(snaps, ks, hot_by_id, width):
+    """{(k0, k1): {slab: log(C(k1) / C(k0)) less the bed's mean}} over consecutive ks."""
+    per_k = {k: contrasts(snaps[k], hot_by_id, width) for k in ks}
+    out = {}
+    for k0, k1 in zip(ks, ks[1:]):
+        slabs = sorted(set(per_k[k0]) & set(per_k[k1]))
+        d = np.array([np.log(per_k[k1][s] / per_k[k0][s]) for s in slabs])
+        out[(k0, k1)] = dict(zip(slabs, d - d.mean()))
+    return out
+
+
+def main(rec_path, extra_path, slab_d, each=False):
+    dem = by_topic(rec_path)["/tdex/snapshots"]
+    ex = by_topic(extra_path)["/tdex/snapshots"]
+    # the extrapolation starts from the DEM's t1; its period t0 -> t1 is the recorded one
+    ex = {**{k: dem[k] for k in dem if k <= 1}, **{k: v for k, v in ex.items() if k >= 2}}
+    width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
+    at_t0 = by_id(dem[min(dem)], "T")
+    hot_by_id = at_t0 > at_t0.mean()
+    ks = [k for k in sorted(dem) if k in ex]
+    print(f"slabs of {slab_d:g} diameters; decay = ln(contrast at the end / at the start), "
+          "less the bed's mean")
+    for name, snaps in [("DEM reference", dem), ("extrapolation", ex)]:
+        an = decays(snaps, ks, hot_by_id, width)
+        periods = list(an)
+        rms = " ".join(
+            f"t{a}-t{b} {np.sqrt(np.mean(np.square(list(an[(a, b)].values())))):.3f}"
+            for a, b in periods
+        )
+        corr = []
+        for p, q in zip(periods, periods[1:]):
+            slabs = sorted(set(an[p]) & set(an[q]))
+            x = np.array([an[p][s] for s in slabs])
+            y = np.array([an[q][s] for s in slabs])
+            corr.append(f"t{p[0]}-t{p[1]} with t{q[0]}-t{q[1]} {np.corrcoef(x, y)[0, 1]:+.2f}")
+        print(f"{name}: anomaly rms {rms}")
+        print(f"  correlation across {len(slabs)} slabs: " + ", ".join(corr))
+        if each:
+            every = sorted(set.union(*(set(a) for a in an.values())))
+            print("  per slab (its middle in diameters along the axis): " + " ".join(
+                f"{(b + 0.5) * slab_d:+.0f}" for b in every))
+            for a, b in periods:
+                print(f"    t{a}-t{b} " + " ".join(
+                    f"{an[(a, b)][s]:+.3f}" if s in an[(a, b)] else "   –  " for s in every))
+
+
+if __name__ == "__main__":
+    args = [a for a in sys.argv[1:] if a != "--each"]
+    if len(args) != 3:
+        sys.exit(__doc__)
+    main(args[0], args[1], float(args[2]), "--each" in sys.argv)
