@@ -48,8 +48,10 @@ def decays(snaps, ks, hot_by_id, width):
 def main(rec_path, extra_path, slab_d, each=False):
     dem = by_topic(rec_path)["/tdex/snapshots"]
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    # the extrapolation starts from the DEM's t1; its period t0 -> t1 is the recorded one
-    ex = {**{k: dem[k] for k in dem if k <= 1}, **{k: v for k, v in ex.items() if k >= 2}}
+    # the extrapolation starts from the DEM's last recorded snapshot (its first one, t1 with one
+    # recorded period); the periods up to it are the recorded ones
+    start = min(ex)
+    ex = {**{k: dem[k] for k in dem if k <= start}, **{k: v for k, v in ex.items() if k > start}}
     width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
     at_t0 = by_id(dem[min(dem)], "T")
     hot_by_id = at_t0 > at_t0.mean()
