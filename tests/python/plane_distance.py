@@ -47,7 +47,7 @@ def main(rec_path, extra_path, edge_d):
         for k in ks:
             runs = [flattened(r[k], axis) for r in [dem] + twins]
             e = flattened(ex[k], axis)
-            ratios.append(ratios_to_runs(runs, [e], lambda a, b: distance(a, b, edge)[0])[0])
+            ratios.append(ratios_to_runs(runs, [e], lambda a, b: distance(a, b, edge)[0])[1][0])
         print(f"{name:<28} " + " ".join(f"{r:<5.2f}" for r in ratios) + f" {np.median(ratios):.2f}")
 
 

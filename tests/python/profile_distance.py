@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic, dem_pairs, ratios_to_runs, well_filled
+from spread import by_topic, ratios_to_runs, well_filled
 
 DIRECTIONS = ["x", "y", "z", "depth"]
 
@@ -88,9 +88,9 @@ def main(rec_path, bin_d, extra_paths, each=False):
             def along(a, b):
                 return distance(a, b, direction, width)
 
-            ratios.append(ratios_to_runs(runs, [e[k] for e in extras], along))
+            pairs, to_runs = ratios_to_runs(runs, [e[k] for e in extras], along)
+            ratios.append(to_runs)
             if each:
-                pairs = np.mean(dem_pairs(runs, along))
                 print(
                     f"  {direction} t{k}: DEM pairs {pairs:.4f} K, ratio "
                     + " ".join(f"{x:.2f}" for x in ratios[-1])

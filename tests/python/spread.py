@@ -49,10 +49,10 @@ def dem_pairs(runs, distance):
 
 
 def ratios_to_runs(runs, extras, distance):
-    """Per extrapolation, its mean distance to the DEM runs over the DEM pairs' mean distance
-    (`distance(a, b)`, a float; the run first, as its cells choose what is compared)."""
+    """The DEM pairs' mean distance, and per extrapolation its mean distance to the DEM runs
+    over it (`distance(a, b)`, a float; the run first, as its cells choose what is compared)."""
     pairs = np.mean(dem_pairs(runs, distance))
-    return [float(np.mean([distance(r, e) for r in runs]) / pairs) for e in extras]
+    return pairs, [float(np.mean([distance(r, e) for r in runs]) / pairs) for e in extras]
 
 
 def main(recording, extra):
