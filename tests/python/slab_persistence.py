@@ -12,7 +12,10 @@ log of its contrast at the end over that at the start; less the bed's mean decay
 period, it is the slab's anomaly: how much faster or slower than the bed it mixed. Printed, for
 the DEM reference and the extrapolation: the anomalies' rms per period, and the correlation
 across slabs of the anomalies of consecutive periods, over all slabs and without the
-INNER_DROP slabs at each end. The replay applies the recorded
+INNER_DROP slabs at each end; then, over each replayed period, the correlation of the
+extrapolation's anomalies with the DEM's and their least-squares ratio (how much larger the
+replay's pattern is). One DEM run: without twins the DEM's own spread of these figures is not
+measured. The replay applies the recorded
 period's contacts every period, so where a slab's rate is set by its contacts rather than by
 the temperature pattern it holds, the replay's correlations are high. If they are and the
 DEM's are low, each DEM revolution draws its slabs' rates anew and the replay's repetition
@@ -58,8 +61,9 @@ def main(rec_path, extra_path, slab_d, each=False):
     ks = [k for k in sorted(dem) if k in ex]
     print(f"slabs of {slab_d:g} diameters; decay = ln(contrast at the end / at the start), "
           "less the bed's mean")
+    anomalies = {}
     for name, snaps in [("DEM reference", dem), ("extrapolation", ex)]:
-        an = decays(snaps, ks, hot_by_id, width)
+        an = anomalies[name] = decays(snaps, ks, hot_by_id, width)
         periods = list(an)
         rms = " ".join(
             f"t{a}-t{b} {np.sqrt(np.mean(np.square(list(an[(a, b)].values())))):.3f}"
@@ -82,6 +86,18 @@ def main(rec_path, extra_path, slab_d, each=False):
             for a, b in periods:
                 print(f"    t{a}-t{b} " + " ".join(
                     f"{an[(a, b)][s]:+.3f}" if s in an[(a, b)] else "   –  " for s in every))
+    # Over the periods the extrapolation replays: is its pattern the DEM's, and how large?
+    dem_an, ex_an = anomalies["DEM reference"], anomalies["extrapolation"]
+    same = []
+    for p in dem_an:
+        if p[0] < start:
+            continue
+        slabs = sorted(set(dem_an[p]) & set(ex_an[p]))
+        x = np.array([dem_an[p][s] for s in slabs])
+        y = np.array([ex_an[p][s] for s in slabs])
+        same.append(f"t{p[0]}-t{p[1]} correlation {np.corrcoef(x, y)[0, 1]:+.2f}, "
+                    f"{(x @ y) / (x @ x):.2f} times the DEM's")
+    print("extrapolation against the DEM, least squares: " + "; ".join(same))
 
 
 if __name__ == "__main__":
