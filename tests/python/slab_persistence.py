@@ -3,8 +3,8 @@
 docs/validation.md, "Where the pilot drum's excess is")
 
 usage: slab_persistence.py [--each] RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with
-       --reference K; the drum's axis is y; SLAB_D: the slabs' width in particle diameters;
-       --each also prints every slab's anomaly per period)
+       --reference K [--twins M]; the drum's axis is y; SLAB_D: the slabs' width in particle
+       diameters; --each also prints every slab's anomaly per period)
 
 Per axial slab and snapshot, the hot-cold contrast of slab_contrast.py (the mean temperature of
 the particles hot at t0 less that of those cold at t0). Over each period, a slab's decay is the
@@ -14,8 +14,10 @@ the DEM reference and the extrapolation: the anomalies' rms per period, and the 
 across slabs of the anomalies of consecutive periods, over all slabs and without the
 INNER_DROP slabs at each end; then, over each replayed period, the correlation of the
 extrapolation's anomalies with the DEM's and their least-squares ratio (how much larger the
-replay's pattern is). One DEM run: without twins the DEM's own spread of these figures is not
-measured. The replay applies the recorded
+replay's pattern is), and the rms of their difference. With twins (DEM runs that leave the
+reference at t1), the same three figures for each twin against the reference: the DEM's own
+spread, the yardstick for the extrapolation's (without twins it is not measured). The replay
+applies the recorded
 period's contacts every period, so where a slab's rate is set by its contacts rather than by
 the temperature pattern it holds, the replay's correlations are high. If they are and the
 DEM's are low, each DEM revolution draws its slabs' rates anew and the replay's repetition
@@ -48,13 +50,33 @@ def decays(snaps, ks, hot_by_id, width):
     return out
 
 
+def against(dem_an, other_an, start):
+    """Per period from `start` on: the correlation across slabs of `other_an` with `dem_an`, the
+    least-squares ratio of the first to the second, and the rms of their difference."""
+    out = []
+    for p in dem_an:
+        if p[0] < start or p not in other_an:
+            continue
+        slabs = sorted(set(dem_an[p]) & set(other_an[p]))
+        x = np.array([dem_an[p][s] for s in slabs])
+        y = np.array([other_an[p][s] for s in slabs])
+        out.append(f"t{p[0]}-t{p[1]} correlation {np.corrcoef(x, y)[0, 1]:+.2f}, "
+                   f"{(x @ y) / (x @ x):.2f} times the DEM's, rms difference "
+                   f"{np.sqrt(np.mean((y - x) ** 2)):.3f}")
+    return out
+
+
 def main(rec_path, extra_path, slab_d, each=False):
-    dem = by_topic(rec_path)["/tdex/snapshots"]
+    rec = by_topic(rec_path)
+    dem = rec["/tdex/snapshots"]
     ex = by_topic(extra_path)["/tdex/snapshots"]
     # the extrapolation starts from the DEM's last recorded snapshot (its first one, t1 with one
     # recorded period); the periods up to it are the recorded ones
     start = min(ex)
     ex = {**{k: dem[k] for k in dem if k <= start}, **{k: v for k, v in ex.items() if k > start}}
+    # a twin leaves the reference at t1: its periods up to t1 are the reference's
+    twins = [{**{k: dem[k] for k in dem if k <= 1}, **rec[t]}
+             for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
     width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
     at_t0 = by_id(dem[min(dem)], "T")
     hot_by_id = at_t0 > at_t0.mean()
@@ -86,18 +108,15 @@ def main(rec_path, extra_path, slab_d, each=False):
             for a, b in periods:
                 print(f"    t{a}-t{b} " + " ".join(
                     f"{an[(a, b)][s]:+.3f}" if s in an[(a, b)] else "   –  " for s in every))
-    # Over the periods the extrapolation replays: is its pattern the DEM's, and how large?
-    dem_an, ex_an = anomalies["DEM reference"], anomalies["extrapolation"]
-    same = []
-    for p in dem_an:
-        if p[0] < start:
-            continue
-        slabs = sorted(set(dem_an[p]) & set(ex_an[p]))
-        x = np.array([dem_an[p][s] for s in slabs])
-        y = np.array([ex_an[p][s] for s in slabs])
-        same.append(f"t{p[0]}-t{p[1]} correlation {np.corrcoef(x, y)[0, 1]:+.2f}, "
-                    f"{(x @ y) / (x @ x):.2f} times the DEM's")
-    print("extrapolation against the DEM, least squares: " + "; ".join(same))
+    # Over the periods the extrapolation replays: is its pattern the DEM's, and how large? And
+    # how far does a second DEM run's pattern stray from the reference's over the same periods?
+    dem_an = anomalies["DEM reference"]
+    for m, twin in enumerate(twins):
+        tks = [k for k in ks if k in twin]
+        print(f"twin {m + 1} against the DEM, least squares: " + "; ".join(
+            against(dem_an, decays(twin, tks, hot_by_id, width), 1)))
+    print("extrapolation against the DEM, least squares: " + "; ".join(
+        against(dem_an, anomalies["extrapolation"], start)))
 
 
 if __name__ == "__main__":

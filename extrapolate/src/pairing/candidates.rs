@@ -448,6 +448,30 @@ impl Graph {
         self.cols.len()
     }
 
+    /// How local the rows are in memory, for the trace: the mean over rows of the span
+    /// of their column indices (largest less smallest) and of the number of distinct
+    /// 64-byte lines their columns occupy in an array of 8 bytes per column (the
+    /// auction's potentials). A bid or a Dijkstra scan waits on those lines, so the
+    /// renumbering (`order.rs`) is judged by them (docs/benchmarks.md, "Pairing the
+    /// long kiln: cubic Morton cells").
+    pub(crate) fn locality(&self) -> (f64, f64) {
+        let (span, lines) = (0..self.rows())
+            .into_par_iter()
+            .map(|p| {
+                let cols = self.row(p).0;
+                let (Some(lo), Some(hi)) = (cols.iter().min(), cols.iter().max()) else {
+                    return (0u64, 0u64);
+                };
+                let mut line: Vec<u32> = cols.iter().map(|&q| q / 8).collect();
+                line.sort_unstable();
+                line.dedup();
+                (u64::from(hi - lo), line.len() as u64)
+            })
+            .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+        let rows = self.rows().max(1) as f64;
+        (span as f64 / rows, lines as f64 / rows)
+    }
+
     /// The edges of row `p`: columns and costs.
     #[inline]
     pub(crate) fn row(&self, p: usize) -> (&[u32], &[EdgeCost]) {
@@ -581,6 +605,14 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// Two rows of three columns: 0, 7, 8 span 8 indices on two lines of eight
+    /// columns; 100, 101, 102 span 2 on one.
+    #[test]
+    fn locality_counts_spans_and_lines() {
+        let g = Graph::from_knn(3, vec![0, 7, 8, 100, 101, 102], vec![1; 6]);
+        assert_eq!(g.locality(), (5.0, 1.5));
     }
 
     /// The grid's k nearest are the brute force's (by squared distance, ties to the

@@ -432,6 +432,13 @@ fn sparse(
     let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
     trace!(t, "knn k {k0}");
     let mut graph = candidates::Graph::from_knn(k0, kc, kw);
+    if trace_on() {
+        let (span, lines) = graph.locality();
+        trace!(
+            t,
+            "locality: a row's columns span {span:.0} indices on {lines:.1} cache lines"
+        );
+    }
     let cheapest = sparse_lap::Cheapest::of(&graph);
     let rho = cheapest.mean() * scale.unit();
     trace!(
