@@ -1,0 +1,78 @@
+#!/usr/bin/env python3
+"""How fast does each axial slab mix at the particle scale, in the DEM runs and in the
+replay? (diagnostic, docs/validation.md, "Where the pilot drum's excess is"; needs scipy)
+
+usage: slab_mixing.py RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with --reference K
+       [--twins M]; the drum's axis is y; SLAB_D: the slabs' width in particle diameters)
+
+Two measures, per axial slab and t_k, for the DEM reference, each twin and the extrapolation:
+- separation: the particles in contact at t1 (centres within 1.05 diameters; the state all
+  the runs share), and the mean over those pairs of log2(their distance at t_k / d), in the
+  slab the pair held at t1. How fast neighbours part: the stretching of the flow.
+- hot-cold contacts: of the contacts at t_k in the slab, the share between a particle hot at
+  t0 and one cold at t0 (hot: above the bed mean at t0). How far the two groups are mixed
+  at the particle scale, where conduction acts: a slab's hot-cold contrast decays with it.
+Then, per t_k, each run's difference to the reference over the slabs (mean and rms): the
+twins' is the DEM's own spread, against which the extrapolation's is judged.
+"""
+import sys
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from spread import by_id, by_topic
+
+TOUCH = 1.05  # contact: centres within this many diameters
+
+
+def positions(points):
+    return by_id(points, "x", "y", "z")
+
+
+def main(rec_path, extra_path, slab_d):
+    rec = by_topic(rec_path)
+    dem = rec["/tdex/snapshots"]
+    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    ex = by_topic(extra_path)["/tdex/snapshots"]
+    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
+    at_t0 = by_id(dem[min(dem)], "T")
+    hot = at_t0 > at_t0.mean()
+    x1 = positions(dem[1])
+    pairs = cKDTree(x1).query_pairs(TOUCH * d, output_type="ndarray")
+    slab_t1 = np.floor(x1[pairs[:, 0], 1] / (slab_d * d)).astype(np.int64)
+    keys, counts = np.unique(slab_t1, return_counts=True)
+    slabs = keys[counts >= 0.5 * np.median(counts)]  # thin end slabs left out
+
+    def separation(points):
+        x = positions(points)
+        s = np.log2(np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1) / d)
+        return np.array([s[slab_t1 == b].mean() for b in slabs])
+
+    def hot_cold(points):
+        x = positions(points)
+        touching = cKDTree(x).query_pairs(TOUCH * d, output_type="ndarray")
+        mixed = hot[touching[:, 0]] != hot[touching[:, 1]]
+        slab = np.floor(x[touching[:, 0], 1] / (slab_d * d)).astype(np.int64)
+        return np.array([mixed[slab == b].mean() for b in slabs])
+
+    print(f"{len(pairs)} pairs in contact at t1; {len(slabs)} slabs of {slab_d:g} diameters, "
+          f"middles {(slabs[0] + 0.5) * slab_d:+.1f} … {(slabs[-1] + 0.5) * slab_d:+.1f} d")
+    names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
+    for label, measure in [("separation, mean log2(distance / d)", separation),
+                           ("hot-cold share of the contacts", hot_cold)]:
+        print(label)
+        for k in sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins)):
+            rows = [measure(r[k]) for r in [dem] + twins + [ex]]
+            for name, row in zip(names, rows):
+                print(f"  t{k} {name:13s} " + " ".join(f"{v:.3f}" for v in row)
+                      + f"  mean {row.mean():.4f}")
+            diff = "; ".join(
+                f"{name} mean {(row - rows[0]).mean():+.4f} rms {np.sqrt(np.mean((row - rows[0]) ** 2)):.4f}"
+                for name, row in zip(names[1:], rows[1:]))
+            print(f"  t{k} less the reference: {diff}")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 4:
+        sys.exit(__doc__)
+    main(sys.argv[1], sys.argv[2], float(sys.argv[3]))
