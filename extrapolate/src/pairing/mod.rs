@@ -433,6 +433,8 @@ fn sparse(
     trace!(t, "knn k {k0}");
     let mut graph = candidates::Graph::from_knn(k0, kc, kw);
     if trace_on() {
+        // A pass over the graph (a few milliseconds on 80 000 rows, in the stamps that
+        // follow): only with the trace on.
         let (span, lines) = graph.locality();
         trace!(
             t,
