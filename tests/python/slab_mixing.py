@@ -13,8 +13,14 @@ Two measures, per axial slab and t_k, for the DEM reference, each twin and the e
   t0 and one cold at t0 (hot: above the bed mean at t0). How far the two groups are mixed
   at the particle scale, where conduction acts: a slab's hot-cold contrast decays with it.
 Then, per t_k, each run's difference to the reference over the slabs (mean and rms): the
-twins' is the DEM's own spread, against which the extrapolation's is judged.
+twins' is the DEM's own spread, against which the extrapolation's is judged. If the pairing
+the extrapolation used is stored beside the recording (RECORDING.pairing.json, one recorded
+period), the separation's difference to the reference is also given by the pair's jump (the
+larger of its two particles' |x1[p] − x0[g(p)]|), and by its velocity mismatch (the larger
+|v1[p] − v0[g(p)]|), in fifths of the pairs.
 """
+import json
+import os
 import sys
 
 import numpy as np
@@ -43,9 +49,12 @@ def main(rec_path, extra_path, slab_d):
     keys, counts = np.unique(slab_t1, return_counts=True)
     slabs = keys[counts >= 0.5 * np.median(counts)]  # thin end slabs left out
 
-    def separation(points):
+    def pair_separation(points):
         x = positions(points)
-        s = np.log2(np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1) / d)
+        return np.log2(np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1) / d)
+
+    def separation(points):
+        s = pair_separation(points)
         return np.array([s[slab_t1 == b].mean() for b in slabs])
 
     def hot_cold(points):
@@ -70,7 +79,28 @@ def main(rec_path, extra_path, slab_d):
                 f"{name} mean {(row - rows[0]).mean():+.4f} rms {np.sqrt(np.mean((row - rows[0]) ** 2)):.4f}"
                 for name, row in zip(names[1:], rows[1:]))
             print(f"  t{k} less the reference: {diff}")
-
+    sidecar = rec_path + ".pairing.json"
+    if os.path.exists(sidecar) and min(ex) == 1:
+        g = np.array(json.load(open(sidecar))["g"])
+        v0, v1 = (by_id(dem[k], "vx", "vy", "vz") for k in (0, 1))
+        per_particle = [
+            ("jump through the pairing (d)",
+             np.linalg.norm(x1 - positions(dem[0])[g], axis=1) / d, 2),
+            ("velocity mismatch through the pairing (m/s)",
+             np.linalg.norm(v1 - v0[g], axis=1), 3),
+        ]
+        for label, value, digits in per_particle:
+            key = np.maximum(value[pairs[:, 0]], value[pairs[:, 1]])
+            edges = np.quantile(key, np.linspace(0.0, 1.0, 6))
+            fifth = np.clip(np.searchsorted(edges, key, side="right") - 1, 0, 4)
+            print(f"separation less the reference's, by the pair's {label}")
+            for k in sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins)):
+                ref = pair_separation(dem[k])
+                for name, run in zip(names[1:], twins + [ex]):
+                    diff = pair_separation(run[k]) - ref
+                    print(f"  t{k} {name:13s} " + "; ".join(
+                        f"{edges[i]:.{digits}f}–{edges[i + 1]:.{digits}f} {diff[fifth == i].mean():+.3f}"
+                        for i in range(5)))
 
 if __name__ == "__main__":
     if len(sys.argv) != 4:
