@@ -17,7 +17,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
+from spread import by_topic, dem_runs
 
 
 def lacey(points, hot_by_id, edge):
@@ -36,9 +36,9 @@ def lacey(points, hot_by_id, edge):
 
 def main():
     rec, extra, ks = sys.argv[1], sys.argv[2], [int(k) for k in sys.argv[3:]]
-    dem = by_topic(rec)
+    reference, twins = dem_runs(rec)
     ext = by_topic(extra)["/tdex/snapshots"]
-    runs = [dem["/tdex/snapshots"]] + [dem[t] for t in sorted(dem) if t.startswith("/tdex/twins/")]
+    runs = [reference] + twins
     t0 = runs[0][0]
     hot_by_id = np.zeros(len(t0), bool)
     hot_by_id[t0["id"]] = t0["T"] > t0["T"].mean()

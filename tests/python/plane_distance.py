@@ -17,7 +17,7 @@ import sys
 import numpy as np
 
 from scale_distance import distance
-from spread import by_topic, ratios_to_runs
+from spread import by_topic, dem_runs, ratios_to_runs
 
 PLANES = [("y", "x-z, whole axis"), ("x", "y-z, whole width"), ("z", "x-y, whole height"), (None, "3-D cells")]
 
@@ -32,9 +32,7 @@ def flattened(points, axis):
 
 
 def main(rec_path, extra_path, edge_d):
-    rec = by_topic(rec_path)
-    dem = rec["/tdex/snapshots"]
-    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    dem, twins = dem_runs(rec_path)
     if not twins:
         sys.exit(f"{rec_path} holds no DEM twin: record it with --twins 1 or more")
     ex = by_topic(extra_path)["/tdex/snapshots"]

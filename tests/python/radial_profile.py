@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic
+from spread import by_topic, dem_runs
 
 EDGES = [0, 1, 2, 4, 8, 1e9]
 
@@ -33,9 +33,9 @@ def profile(points, radius_drum, d):
 
 def main():
     rec, extra, ks = sys.argv[1], sys.argv[2], [int(k) for k in sys.argv[3:]]
-    dem = by_topic(rec)
+    reference, twins = dem_runs(rec)
     ext = by_topic(extra)["/tdex/snapshots"]
-    runs = [dem["/tdex/snapshots"]] + [dem[t] for t in sorted(dem) if t.startswith("/tdex/twins/")]
+    runs = [reference] + twins
     first = runs[0][0]
     d = 2 * first["r"].mean()
     # the mantle's radius: the farthest particle centre from the axis plus a radius

@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic
+from spread import by_id, by_topic, dem_runs
 
 
 def positions(points):
@@ -24,9 +24,7 @@ def positions(points):
 
 
 def main(rec_path, extra_path):
-    rec = by_topic(rec_path)
-    dem = rec["/tdex/snapshots"]
-    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    dem, twins = dem_runs(rec_path)
     extra = by_topic(extra_path)["/tdex/snapshots"]
     d = 2.0 * float(np.median(dem[min(dem)]["r"]))
     print("mean |dx| |dy| |dz| of the same particle against the reference (diameters)")

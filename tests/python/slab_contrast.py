@@ -15,7 +15,7 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic, well_filled
+from spread import by_id, by_topic, dem_runs, well_filled
 
 
 def contrasts(points, hot_by_id, width):
@@ -33,9 +33,7 @@ def contrasts(points, hot_by_id, width):
 
 
 def main(rec_path, extra_path, slab_d):
-    rec = by_topic(rec_path)
-    dem = rec["/tdex/snapshots"]
-    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    dem, twins = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
     width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
     at_t0 = by_id(dem[min(dem)], "T")

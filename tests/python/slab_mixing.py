@@ -26,7 +26,7 @@ import sys
 import numpy as np
 from scipy.spatial import cKDTree
 
-from spread import by_id, by_topic
+from spread import by_id, by_topic, dem_runs
 
 TOUCH = 1.05  # contact: centres within this many diameters
 
@@ -36,9 +36,7 @@ def positions(points):
 
 
 def main(rec_path, extra_path, slab_d):
-    rec = by_topic(rec_path)
-    dem = rec["/tdex/snapshots"]
-    twins = [rec[t] for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    dem, twins = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
     d = 2.0 * float(np.median(dem[min(dem)]["r"]))
     at_t0 = by_id(dem[min(dem)], "T")
@@ -67,10 +65,11 @@ def main(rec_path, extra_path, slab_d):
     print(f"{len(pairs)} pairs in contact at t1; {len(slabs)} slabs of {slab_d:g} diameters, "
           f"middles {(slabs[0] + 0.5) * slab_d:+.1f} … {(slabs[-1] + 0.5) * slab_d:+.1f} d")
     names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
+    ks = sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins))
     for label, measure in [("separation, mean log2(distance / d)", separation),
                            ("hot-cold share of the contacts", hot_cold)]:
         print(label)
-        for k in sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins)):
+        for k in ks:
             rows = [measure(r[k]) for r in [dem] + twins + [ex]]
             for name, row in zip(names, rows):
                 print(f"  t{k} {name:13s} " + " ".join(f"{v:.3f}" for v in row)
@@ -94,13 +93,14 @@ def main(rec_path, extra_path, slab_d):
             edges = np.quantile(key, np.linspace(0.0, 1.0, 6))
             fifth = np.clip(np.searchsorted(edges, key, side="right") - 1, 0, 4)
             print(f"separation less the reference's, by the pair's {label}")
-            for k in sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins)):
+            for k in ks:
                 ref = pair_separation(dem[k])
                 for name, run in zip(names[1:], twins + [ex]):
                     diff = pair_separation(run[k]) - ref
                     print(f"  t{k} {name:13s} " + "; ".join(
                         f"{edges[i]:.{digits}f}–{edges[i + 1]:.{digits}f} {diff[fifth == i].mean():+.3f}"
                         for i in range(5)))
+
 
 if __name__ == "__main__":
     if len(sys.argv) != 4:

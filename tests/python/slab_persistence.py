@@ -31,7 +31,7 @@ import sys
 import numpy as np
 
 from slab_contrast import contrasts
-from spread import by_id, by_topic
+from spread import by_id, by_topic, dem_runs
 
 # The "inner" correlation leaves out this many slabs at each end: the end caps' drag makes
 # the slabs beside them mix faster in every revolution, a drum property that would
@@ -67,16 +67,14 @@ def against(dem_an, other_an, start):
 
 
 def main(rec_path, extra_path, slab_d, each=False):
-    rec = by_topic(rec_path)
-    dem = rec["/tdex/snapshots"]
+    dem, twin_runs = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
     # the extrapolation starts from the DEM's last recorded snapshot (its first one, t1 with one
     # recorded period); the periods up to it are the recorded ones
     start = min(ex)
     ex = {**{k: dem[k] for k in dem if k <= start}, **{k: v for k, v in ex.items() if k > start}}
     # a twin leaves the reference at t1: its periods up to t1 are the reference's
-    twins = [{**{k: dem[k] for k in dem if k <= 1}, **rec[t]}
-             for t in sorted(t for t in rec if t.startswith("/tdex/twins/"))]
+    twins = [{**{k: dem[k] for k in dem if k <= 1}, **twin} for twin in twin_runs]
     width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
     at_t0 = by_id(dem[min(dem)], "T")
     hot_by_id = at_t0 > at_t0.mean()

@@ -28,6 +28,15 @@ def by_topic(path):
     return out
 
 
+def dem_runs(path):
+    """The DEM runs of a recording: the reference's snapshots and each twin's, in the order of
+    their topics ({t_k: points} each; a twin holds the t_k after t1, where it left the
+    reference)."""
+    rec = by_topic(path)
+    reference = rec.pop("/tdex/snapshots")
+    return reference, [rec[t] for t in sorted(rec)]
+
+
 def by_id(points, *fields):
     """The named fields in particle-id order: a vector for one field, one column per field."""
     out = np.empty((len(points), len(fields)))
@@ -56,9 +65,7 @@ def ratios_to_runs(runs, extras, distance):
 
 
 def main(recording, extra):
-    runs = by_topic(recording)
-    dem = runs.pop("/tdex/snapshots")
-    twins = [runs[t] for t in sorted(runs)]
+    dem, twins = dem_runs(recording)
     ex = by_topic(extra)["/tdex/snapshots"]
     for k in sorted(ex):
         if k not in dem:
