@@ -17,7 +17,7 @@ import sys
 import numpy as np
 
 from scale_distance import distance
-from spread import by_topic, dem_runs, ratios_to_runs
+from spread import by_topic, compared_ks, dem_runs, diameter, ratios_to_runs
 
 PLANES = [("y", "x-z, whole axis"), ("x", "y-z, whole width"), ("z", "x-y, whole height"), (None, "3-D cells")]
 
@@ -36,8 +36,8 @@ def main(rec_path, extra_path, edge_d):
     if not twins:
         sys.exit(f"{rec_path} holds no DEM twin: record it with --twins 1 or more")
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    edge = edge_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
-    ks = [k for k in sorted(dem) if k >= 2 and k in ex and all(k in t for t in twins)]
+    edge = edge_d * diameter(dem)
+    ks = compared_ks(dem, twins, ex)
     print(f"cells of {edge_d:g} diameters in the plane, the whole bed across it; ratio per t_k")
     print(f"{'plane':<28} " + " ".join(f"t{k:<4}" for k in ks) + " median")
     for axis, name in PLANES:

@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic, dem_pairs, dem_runs, well_filled
+from spread import by_topic, dem_pairs, dem_runs, diameter, well_filled
 
 SHIFTS = [np.array([0.37, 0.53, 0.71]) * o / 4 for o in range(4)]
 
@@ -63,7 +63,7 @@ def distance(a, b, edge):
 def main(rec_path, extra_path, edges_d):
     dem, twins = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
+    d = diameter(dem)
     ks = sorted(k for k in ex if k in dem and k >= 2)
     print(f"cells in particle diameters (d = {d * 1e3:g} mm); distances in K")
     for edge_d in edges_d:

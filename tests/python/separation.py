@@ -16,7 +16,7 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic, dem_runs
+from spread import by_id, by_topic, dem_runs, diameter
 
 
 def positions(points):
@@ -26,7 +26,7 @@ def positions(points):
 def main(rec_path, extra_path):
     dem, twins = dem_runs(rec_path)
     extra = by_topic(extra_path)["/tdex/snapshots"]
-    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
+    d = diameter(dem)
     print("mean |dx| |dy| |dz| of the same particle against the reference (diameters)")
     for k in (k for k in sorted(dem) if k >= 2 and k in extra):
         ref = positions(dem[k])

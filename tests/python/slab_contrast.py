@@ -15,13 +15,14 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic, dem_runs, well_filled
+from spread import (axial_slab, by_topic, compared_ks, dem_runs, diameter, hot_at_t0, run_names,
+                    well_filled)
 
 
 def contrasts(points, hot_by_id, width):
     """{slab: hot mean − cold mean} over the well-filled slabs."""
     hot = hot_by_id[points["id"]]
-    slab = np.floor(points["y"] / width).astype(np.int64)
+    slab = axial_slab(points["y"], width)
     keys, index, counts = np.unique(slab, return_inverse=True, return_counts=True)
     index = index.ravel()
     n_hot = np.bincount(index, weights=hot)
@@ -35,12 +36,11 @@ def contrasts(points, hot_by_id, width):
 def main(rec_path, extra_path, slab_d):
     dem, twins = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
-    at_t0 = by_id(dem[min(dem)], "T")
-    hot_by_id = at_t0 > at_t0.mean()
-    names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
+    width = slab_d * diameter(dem)
+    hot_by_id = hot_at_t0(dem)
+    names = run_names(twins)
     print(f"slabs of {slab_d:g} diameters; K")
-    for k in (k for k in sorted(dem) if k >= 2 and k in ex and all(k in t for t in twins)):
+    for k in compared_ks(dem, twins, ex):
         runs = [contrasts(r[k], hot_by_id, width) for r in [dem] + twins + [ex]]
         slabs = sorted(set.intersection(*(set(c) for c in runs)))
         v = np.array([[c[b] for b in slabs] for c in runs])

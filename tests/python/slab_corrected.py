@@ -27,19 +27,14 @@ import sys
 import numpy as np
 
 from scale_distance import distance
-from spread import by_id, by_topic, dem_runs
+from spread import axial_slab, by_topic, compared_ks, dem_runs, diameter, hot_at_t0, run_names
 
 MIN_FIT = 100
 
 
-def slab_of(points, width):
-    """Each particle's axial slab (the drum's axis is y)."""
-    return np.floor(points["y"] / width).astype(np.int64)
-
-
 def group_slab_keys(points, hot_by_id, width):
     """Each particle's (slab, group) key as one integer: 2 × slab + hot."""
-    return 2 * slab_of(points, width) + hot_by_id[points["id"]].astype(np.int64)
+    return 2 * axial_slab(points["y"], width) + hot_by_id[points["id"]].astype(np.int64)
 
 
 def with_slab_means(run, reference, hot_by_id, width):
@@ -67,7 +62,7 @@ def slab_fits(points, hot_by_id, width):
     and z: the direction and strength of what is left of the hot-cold split in that slab).
     Returns the particles' slabs, their basis rows and {slab: coefficients}; slabs of fewer
     than MIN_FIT particles (the end caps' slivers) are left out."""
-    slab = slab_of(points, width)
+    slab = axial_slab(points["y"], width)
     basis = np.stack([np.ones(len(points)), hot_by_id[points["id"]].astype(float),
                       points["x"], points["z"]]).T
     fits = {}
@@ -109,32 +104,27 @@ def main(rec_path, extra_path, slab_d, edge_d):
     if not twins:
         sys.exit(f"{rec_path}: no DEM twins (record with --twins 1 or more)")
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
+    d = diameter(dem)
     width, edge = slab_d * d, edge_d * d
-    at_t0 = by_id(dem[min(dem)], "T")
-    hot_by_id = at_t0 > at_t0.mean()
-    ks = sorted(k for k in ex if k in dem and k >= 2 and all(k in t for t in twins))
+    hot_by_id = hot_at_t0(dem)
+    ks = compared_ks(dem, twins, ex)
+    names = run_names(twins)
     print(f"slabs of {slab_d:g} d, cubic cells of {edge_d:g} d; distances to the reference in K")
-    ratios = {"as it is": [], "corrected": [], "tilted": []}
+    corrections = {"as it is": None, "corrected": with_slab_means, "tilted": with_slab_fits}
+    ratios = {label: [] for label in corrections}
     for k in ks:
         ref = dem[k]
         line = f"  t{k}:"
-        for label in ratios:
-            def to_ref(run):
-                if label == "corrected":
-                    run = with_slab_means(run, ref, hot_by_id, width)
-                elif label == "tilted":
-                    run = with_slab_fits(run, ref, hot_by_id, width)
-                return distance(ref, run, edge)[0]
-
-            twin_d = [to_ref(t[k]) for t in twins]
-            ex_d = to_ref(ex[k])
+        for label, correct in corrections.items():
+            runs = [t[k] for t in twins] + [ex[k]]
+            if correct:
+                runs = [correct(r, ref, hot_by_id, width) for r in runs]
+            *twin_d, ex_d = [distance(ref, r, edge)[0] for r in runs]
             ratio = ex_d / np.mean(twin_d)
             ratios[label].append(ratio)
             line += (f" {label}: twins " + " ".join(f"{x:.4f}" for x in twin_d)
                      + f", extrapolation {ex_d:.4f}, ratio {ratio:.2f};")
         print(line.rstrip(";"))
-        names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
         print("      tilt (K per 10 d): mean size, rms along the axis, rms to the reference's: "
               + "; ".join(f"{n} {a:.3f} {b:.3f} {c:.3f}" for n, (a, b, c) in zip(
                   names, tilts([ref] + [t[k] for t in twins] + [ex[k]], hot_by_id, width, d))))

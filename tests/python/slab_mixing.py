@@ -26,7 +26,7 @@ import sys
 import numpy as np
 from scipy.spatial import cKDTree
 
-from spread import by_id, by_topic, dem_runs
+from spread import axial_slab, by_id, by_topic, compared_ks, dem_runs, diameter, hot_at_t0, run_names
 
 TOUCH = 1.05  # contact: centres within this many diameters
 
@@ -38,12 +38,11 @@ def positions(points):
 def main(rec_path, extra_path, slab_d):
     dem, twins = dem_runs(rec_path)
     ex = by_topic(extra_path)["/tdex/snapshots"]
-    d = 2.0 * float(np.median(dem[min(dem)]["r"]))
-    at_t0 = by_id(dem[min(dem)], "T")
-    hot = at_t0 > at_t0.mean()
+    d = diameter(dem)
+    hot = hot_at_t0(dem)
     x1 = positions(dem[1])
     pairs = cKDTree(x1).query_pairs(TOUCH * d, output_type="ndarray")
-    slab_t1 = np.floor(x1[pairs[:, 0], 1] / (slab_d * d)).astype(np.int64)
+    slab_t1 = axial_slab(x1[pairs[:, 0], 1], slab_d * d)
     keys, counts = np.unique(slab_t1, return_counts=True)
     slabs = keys[counts >= 0.5 * np.median(counts)]  # thin end slabs left out
 
@@ -59,13 +58,13 @@ def main(rec_path, extra_path, slab_d):
         x = positions(points)
         touching = cKDTree(x).query_pairs(TOUCH * d, output_type="ndarray")
         mixed = hot[touching[:, 0]] != hot[touching[:, 1]]
-        slab = np.floor(x[touching[:, 0], 1] / (slab_d * d)).astype(np.int64)
+        slab = axial_slab(x[touching[:, 0], 1], slab_d * d)
         return np.array([mixed[slab == b].mean() for b in slabs])
 
     print(f"{len(pairs)} pairs in contact at t1; {len(slabs)} slabs of {slab_d:g} diameters, "
           f"middles {(slabs[0] + 0.5) * slab_d:+.1f} … {(slabs[-1] + 0.5) * slab_d:+.1f} d")
-    names = ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
-    ks = sorted(k for k in dem if k >= 2 and k in ex and all(k in t for t in twins))
+    names = run_names(twins)
+    ks = compared_ks(dem, twins, ex)
     for label, measure in [("separation, mean log2(distance / d)", separation),
                            ("hot-cold share of the contacts", hot_cold)]:
         print(label)

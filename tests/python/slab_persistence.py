@@ -31,7 +31,7 @@ import sys
 import numpy as np
 
 from slab_contrast import contrasts
-from spread import by_id, by_topic, dem_runs
+from spread import by_topic, dem_runs, diameter, hot_at_t0
 
 # The "inner" correlation leaves out this many slabs at each end: the end caps' drag makes
 # the slabs beside them mix faster in every revolution, a drum property that would
@@ -75,9 +75,8 @@ def main(rec_path, extra_path, slab_d, each=False):
     ex = {**{k: dem[k] for k in dem if k <= start}, **{k: v for k, v in ex.items() if k > start}}
     # a twin leaves the reference at t1: its periods up to t1 are the reference's
     twins = [{**{k: dem[k] for k in dem if k <= 1}, **twin} for twin in twin_runs]
-    width = slab_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
-    at_t0 = by_id(dem[min(dem)], "T")
-    hot_by_id = at_t0 > at_t0.mean()
+    width = slab_d * diameter(dem)
+    hot_by_id = hot_at_t0(dem)
     ks = [k for k in sorted(dem) if k in ex]
     print(f"slabs of {slab_d:g} diameters; decay = ln(contrast at the end / at the start), "
           "less the bed's mean")

@@ -37,6 +37,34 @@ def dem_runs(path):
     return reference, [rec[t] for t in sorted(rec)]
 
 
+def diameter(dem):
+    """The particle diameter of a run ({t_k: points}): twice the median radius at its first t_k."""
+    return 2.0 * float(np.median(dem[min(dem)]["r"]))
+
+
+def hot_at_t0(dem):
+    """Per particle id, whether it was hot at t0 (above the bed's mean temperature there): the
+    two groups the hot/cold drums start from."""
+    at_t0 = by_id(dem[min(dem)], "T")
+    return at_t0 > at_t0.mean()
+
+
+def axial_slab(y, width):
+    """The axial slab of each axial coordinate (the drum's axis is y), slabs `width` wide."""
+    return np.floor(y / width).astype(np.int64)
+
+
+def run_names(twins):
+    """The printed names of the reference, each twin and the extrapolation, in that order."""
+    return ["reference"] + [f"twin {m + 1}" for m in range(len(twins))] + ["extrapolation"]
+
+
+def compared_ks(dem, twins, extra):
+    """The t_k after the recorded period (k >= 2) that the reference, every twin and the
+    extrapolation all hold, in order."""
+    return sorted(k for k in dem if k >= 2 and k in extra and all(k in t for t in twins))
+
+
 def by_id(points, *fields):
     """The named fields in particle-id order: a vector for one field, one column per field."""
     out = np.empty((len(points), len(fields)))
