@@ -22,18 +22,18 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic
+from spread import axial_slab, by_id, by_topic, diameter
 
 
 def main(rec_path, bin_d):
     dem = by_topic(rec_path)["/tdex/snapshots"]
     ks = sorted(dem)
-    d = 2.0 * float(np.median(dem[ks[0]]["r"]))
+    d = diameter(dem)
     width = bin_d * d
     fields = []
     for a, b in zip(ks, ks[1:]):
         y0, y1 = by_id(dem[a], "y"), by_id(dem[b], "y")
-        keys, inverse = np.unique(np.floor(y0 / width).astype(np.int64), return_inverse=True)
+        keys, inverse = np.unique(axial_slab(y0, width), return_inverse=True)
         counts = np.bincount(inverse.ravel())
         mean = np.bincount(inverse.ravel(), weights=y1 - y0) / counts / d
         fields.append(dict(zip(keys, mean)))

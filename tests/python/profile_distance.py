@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-from spread import by_topic, dem_runs, ratios_to_runs, well_filled
+from spread import by_topic, dem_runs, diameter, ratios_to_runs, well_filled
 
 DIRECTIONS = ["x", "y", "z", "depth"]
 
@@ -60,7 +60,7 @@ def rms_about_mean(points, direction, width):
 def main(rec_path, bin_d, extra_paths, each=False):
     dem, twins = dem_runs(rec_path)
     extras = [by_topic(p)["/tdex/snapshots"] for p in extra_paths]
-    width = bin_d * 2.0 * float(np.median(dem[min(dem)]["r"]))
+    width = bin_d * diameter(dem)
     ks = [
         k
         for k in sorted(dem)
