@@ -230,7 +230,7 @@ def main(rec_path, extra_path, slab_d, cell_d):
           "its slab anomalies with the recorded's; offset from the DEM's mean over its other "
           "revolutions, rms over slabs (same order) and in units of their spread; share "
           "changing slab")
-    spread = np.std([stack[s] for s in others], 0, ddof=1)
+    offset_spread = np.std([stack[s] for s in others], 0, ddof=1)
     offset = {}
     for s in dem_steps + [replay]:
         pool = [o for o in others if o != s]
@@ -240,7 +240,7 @@ def main(rec_path, extra_path, slab_d, cell_d):
               f"{row(np.sqrt((anomaly[s] ** 2).mean(0)).ravel())}; "
               f"{np.corrcoef(anomaly[s].ravel(), anomaly[recorded].ravel())[0, 1]:+.2f}; "
               f"{row(np.sqrt((offset[s] ** 2).mean(0)).ravel())} "
-              f"({np.sqrt(np.mean((offset[s] / spread) ** 2)):.2f}); {exchange:.3f}")
+              f"({np.sqrt(np.mean((offset[s] / offset_spread) ** 2)):.2f}); {exchange:.3f}")
     pairs = [np.corrcoef(offset[a].ravel(), offset[b].ravel())[0, 1]
              for i, a in enumerate(dem_steps) for b in dem_steps[i + 1:]]
     print(f"  offsets' correlation between two DEM revolutions: mean {np.mean(pairs):+.2f}, "
