@@ -27,7 +27,9 @@ the tilt vectors' difference, as slab_corrected.py's. Printed, in four parts:
 3. A transport model one level finer (the mapping method): cell-mean fields carried by each
    revolution's cell-to-cell particle counts, the same three sequences; plain tilts of T and of
    the hot indicator, and the tilt of slab_corrected.py's [1, hot, x, z] fit (the docs' number),
-   recovered as the plain T tilt less the slab's hot-cold coefficient times the hot tilt.
+   recovered as the plain T tilt less the slab's hot-cold coefficient times the hot tilt; and
+   where along the axis the measured tilt errors lie (common to every slab, or alike in
+   slabs mirrored about the mid-plane).
 4. With the transport model: each DEM revolution repeated as the replay repeats the recorded
    one, random orders of distinct DEM revolutions, two alternating; every map with its axial
    moves taken out, or with only them; and the replay's map with each slab's linear (and cubic)
@@ -312,6 +314,8 @@ def main(rec_path, extra_path, slab_d, cell_d):
                 for n in runs for k in ks}
         own = {(n, k): plain_tilts(pos[(n, k)], temp[(n, k)] if field == "T" else hot, width,
                                    slabs, per) for n in runs for k in ks}
+        if field == "T":
+            own_t = own
         check = [distance(meas[("reference", k)], own[("reference", k)]) for k in ks]
         print(f"  plain tilt of {field}: the cells' estimate against the particles' (reference, "
               f"t{ks[0]}…t{ks[-1]}) {row(check)}")
@@ -328,6 +332,17 @@ def main(rec_path, extra_path, slab_d, cell_d):
           "the reference's:")
     print_compare(ks, docs, combined["a"], combined["b"], {n: combined[n] for n in twin_names},
                   twin_names)
+
+    # where along the axis the measured tilt errors lie: the same in every slab (a structure
+    # along the whole drum), or alike in slabs mirrored about the mid-plane (a structure that
+    # the mirror image repeats rather than cancels); a random pattern has half its squares
+    # even in y and 1/len(slabs) common
+    print("  the measured plain T tilts' errors (run less reference) along the axis: share of "
+          "their squares common to every slab / even in y (slab s with its mirror -s-1)")
+    for n in [r for r in runs if r != "reference"]:
+        shares = [error_shares(own_t[(n, k)] - own_t[("reference", k)], slabs) for k in ks[1:]]
+        print(f"    {n:14s} " + " ".join(f"t{k} {c:.2f}/{e:.2f}" for k, (c, e) in
+                                         zip(ks[1:], shares)))
 
     # ---- 4. repetition and the linear part, plain T tilt, against the model's (b)
     ref_path = model["T"]["b"]
@@ -428,6 +443,20 @@ def main(rec_path, extra_path, slab_d, cell_d):
             print(f"    degree {degree}: {n}'s maps as they are / with the recorded's         "
                   f"{row(to_b(cells_from_t1(sequences[n], t_values)))} / "
                   f"{row(with_fit(sequences[n], per_step[recorded]))}")
+
+
+def error_shares(errors, slabs):
+    """Of the squared tilt errors (one x, z vector per slab), the share common to all slabs
+    (their mean vector) and the share even in y (each slab's averaged with its mirror image's,
+    slab -s-1; slabs without their mirror are left out of that share)."""
+    errors = np.asarray(errors)
+    total = np.sum(errors ** 2, axis=1).mean()
+    common = np.sum(errors.mean(0) ** 2) / total
+    where = {s: i for i, s in enumerate(slabs)}
+    pairs = [(where[s], where[-s - 1]) for s in slabs if -s - 1 in where]
+    even = np.mean([np.sum(((errors[i] + errors[j]) / 2) ** 2) for i, j in pairs])
+    mirrored = np.mean([np.sum(errors[i] ** 2) for i, _ in pairs])
+    return common, even / mirrored
 
 
 def print_compare(ks, measured, a, b, cs, twin_names):
