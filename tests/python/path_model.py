@@ -5,26 +5,28 @@ stray").
 
 usage: path_model.py REFERENCE.mcap RECORDING.mcap [EXTRA.mcap ...]
        REFERENCE: the run recorded with one period and --reference K --twins 1 or more;
-       RECORDING: the same run's revolution after t0 recorded as P periods (--tau-rev 1/P
-       --recorded-periods P), with the pairing of every snapshot t_e (e >= 1) to every other
-       t_s (s < P) stored beside it (`tdex pair` stores those from t_P; the others:
+       RECORDING: the same run recorded from t0 as P periods without a reference, either its
+       first revolution in P sub-periods (--tau-rev 1/P --recorded-periods P) or P whole
+       revolutions (--recorded-periods P), with the pairings the paths below use stored
+       beside it (`tdex pair` stores those from t_P; any other, t_e to t_s:
        `cargo run --release -p extrapolate --example pair_snapshots -- RECORDING e s`);
-       EXTRA: `tdex extrapolate RECORDING` runs, measured at the revolutions after t_P.
+       EXTRA: `tdex extrapolate RECORDING` runs, measured at the revolutions after t1.
 
-Every particle keeps the temperature it had at the end of the revolution (t1 of REFERENCE,
-t_P of RECORDING: the same instant of the same run): the reference's and the twin's particles
-carry it along their own motion, the replay's roles along a path of sub-periods, through a
+Every particle keeps the temperature it had at the end of the first revolution (t1 of
+REFERENCE, the same instant of RECORDING: the same run): the reference's and the twin's
+particles carry it along their own motion, the replay's roles along a path of the recorded
+periods (the DEM's own continuation to the end of the recording, then as drawn), through a
 pairing at every jump (the particle at the end of one sub-period takes the role it is paired
 with at the start of the next), as `tdex extrapolate` moves temperatures, with no heat
 exchanged. Printed at each revolution after t1: the rms over the 10-diameter axial slabs of
 the difference between each run's tilt across the drum (the x and z slopes of the least-squares
 fit of the temperature on [1, x, z], K per 10 diameters) and the reference's, for the twin, for
-the paper's method (the revolution as one period, replayed again and again), and for random
-paths of sub-periods (DRAWS paths each, numpy's generator seeded 1): tdex's path (jumps only
-from the recording's end, to a start drawn uniformly), its halves (with P even: the half
-periods as tdex replays a revolution recorded as two) and jumps from the end of any
-sub-period. Without conduction the tilts stray further than the real runs' (conduction damps
-them), alike for every run; compare the paths with each other and with the twin.
+the paper's method (the first revolution as one period, replayed again and again), and for
+random paths (DRAWS paths each, numpy's generator seeded 1): tdex's path (jumps only from the
+recording's end, to a start drawn uniformly), the half periods (a revolution in P sub-periods,
+P even: as tdex replays a revolution recorded as two) and jumps from the end of any period.
+Without conduction the tilts stray further than the real runs' (conduction damps them), alike
+for every run; compare the paths with each other and with the twin.
 """
 import json
 import sys
@@ -57,8 +59,12 @@ def main(ref_path, rec_path, extra_paths):
     xyz = ("x", "y", "z")
     ref = {k: by_id(dem[k], *xyz) for k in dem}
     sub = {k: by_id(recorded[k], *xyz) for k in recorded}
-    if not (np.array_equal(sub[0], ref[0]) and np.array_equal(sub[P], ref[1])):
-        sys.exit(f"{rec_path}: its t0 and t{P} are not {ref_path}'s t0 and t1 (not the same run)")
+    # the recorded periods per revolution: the snapshot that is the reference's t1
+    per_revolution = next((k for k in sorted(sub) if k > 0 and np.array_equal(sub[k], ref[1])),
+                          None)
+    if not np.array_equal(sub[0], ref[0]) or per_revolution is None:
+        sys.exit(f"{rec_path}: its t0 and none of its snapshots are {ref_path}'s t0 and t1 "
+                 "(not the same run)")
     d = diameter(dem)
     width = per = SLAB_D * d
     t1_temp = by_id(dem[1], "T")
@@ -93,35 +99,36 @@ def main(ref_path, rec_path, extra_paths):
 
     def play(policy, rng):
         """The tilts at each revolution after t1 along the path `policy(at_end_of, rng)` gives
-        (the next sub-period, 1-based: the next one is the DEM's own continuation, any other
-        a jump), and the number of jumps."""
-        values, at, out, jumps = t1_temp.copy(), P, [], 0
-        for step in range(P * len(ks)):
+        (the next recorded period, 1-based: the next one is the DEM's own continuation, any
+        other a jump), and the number of jumps."""
+        values, at, out, jumps = t1_temp.copy(), per_revolution, [], 0
+        for step in range(per_revolution * len(ks)):
             m = policy(at, rng)
             if m != at + 1:
                 moved = np.empty_like(values)
                 moved[pairing(at, m - 1)] = values
                 values, jumps = moved, jumps + 1
             at = m
-            if (step + 1) % P == 0:
+            if (step + 1) % per_revolution == 0:
                 out.append(tilt(sub[at], values))
         return to_reference(out), jumps
 
-    print(f"{ref_path}, {rec_path} ({P} sub-periods); the t1 temperatures carried without "
+    print(f"{ref_path}, {rec_path} ({P} recorded periods, {per_revolution} per revolution); the t1 "
+          "temperatures carried without "
           f"conduction; slab tilts' distance to the reference's at t{ks[0]}…t{ks[-1]} "
           f"(K per {SLAB_D} d)")
     for m, twin in enumerate(twins):
         tilts = [tilt(by_id(twin[k], *xyz), t1_temp) for k in ks]
         print(f"  twin {m + 1}: {row(to_reference(tilts))}")
-    out, jumps = play(lambda at, rng: 1 if at == P else at + 1, None)
+    out, jumps = play(lambda at, rng: 1 if at == per_revolution else at + 1, None)
     print(f"  the revolution as one period (the paper's method): {row(out)}; {jumps} jumps")
     policies = [("tdex's path: jumps from the recording's end only",
                  lambda at, rng: int(rng.integers(1, P + 1)) if at == P else at + 1)]
-    if P % 2 == 0 and P > 2:
+    if per_revolution == P and P % 2 == 0 and P > 2:
         policies.append(("half periods, jumps from the end only",
                          lambda at, rng: 1 + (P // 2) * int(rng.integers(0, 2)) if at == P
                          else at + 1))
-    policies.append(("jumps from the end of any sub-period",
+    policies.append(("jumps from the end of any recorded period",
                      lambda at, rng: int(rng.integers(1, P + 1))))
     for name, policy in policies:
         rng = np.random.default_rng(1)
@@ -129,11 +136,11 @@ def main(ref_path, rec_path, extra_paths):
         dist = np.array([r for r, _ in runs])
         print(f"  {name}, {DRAWS} paths: mean {row(dist.mean(0))}; min {row(dist.min(0))}; "
               f"max {row(dist.max(0))}; {np.mean([j for _, j in runs]):.1f} jumps")
-    # the real extrapolations (with conduction) at the same instants: their snapshot P·k is
-    # the revolution k after t0, the reference's t_k
+    # the real extrapolations (with conduction) at the same instants: their snapshot
+    # per_revolution·k is the revolution k after t0, the reference's t_k
     for path in extra_paths:
         extra = by_topic(path)["/tdex/snapshots"]
-        at_k = {k: extra[P * k] for k in ks if P * k in extra}
+        at_k = {k: extra[per_revolution * k] for k in ks if per_revolution * k in extra}
         measured = [distance(tilt(by_id(dem[k], *xyz), by_id(dem[k], "T")),
                              plain_tilts(np.stack([p[a] for a in xyz], 1), p["T"], width, slabs,
                                          per)) for k, p in at_k.items()]
