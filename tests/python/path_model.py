@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""Which replay path through the sub-periods of one recorded revolution keeps the slabs' tilts
-as a DEM run does? A model without conduction (diagnostic, docs/validation.md, "Why the tilts
+"""Which replay path through a recording's periods (the sub-periods of one revolution, or whole
+revolutions) keeps the slabs' tilts as a DEM run does? A model without conduction (diagnostic, docs/validation.md, "Why the tilts
 stray").
 
 usage: path_model.py REFERENCE.mcap RECORDING.mcap [EXTRA.mcap ...]
@@ -16,7 +16,7 @@ Every particle keeps the temperature it had at the end of the first revolution (
 REFERENCE, the same instant of RECORDING: the same run): the reference's and the twin's
 particles carry it along their own motion, the replay's roles along a path of the recorded
 periods (the DEM's own continuation to the end of the recording, then as drawn), through a
-pairing at every jump (the particle at the end of one sub-period takes the role it is paired
+pairing at every jump (the particle at the end of one period takes the role it is paired
 with at the start of the next), as `tdex extrapolate` moves temperatures, with no heat
 exchanged. Printed at each revolution after t1: the rms over the 10-diameter axial slabs of
 the difference between each run's tilt across the drum (the x and z slopes of the least-squares
