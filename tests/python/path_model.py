@@ -33,9 +33,9 @@ import sys
 
 import numpy as np
 
-from slab_affine import distance, plain_tilts, row
-from slab_corrected import MIN_FIT
-from spread import axial_slab, by_id, by_topic, dem_runs, diameter
+from slab_affine import plain_tilts, row
+from slab_corrected import MIN_FIT, tilt_distance
+from spread import axial_slab, by_id, by_topic, dem_runs, diameter, positions
 
 # random paths per policy: enough for a mean, a min and a max
 DRAWS = 20
@@ -56,9 +56,8 @@ def main(ref_path, rec_path, extra_paths):
         sys.exit(f"{ref_path}: no DEM twins (record with --twins 1 or more)")
     recorded = by_topic(rec_path)["/tdex/snapshots"]
     P = max(recorded)
-    xyz = ("x", "y", "z")
-    ref = {k: by_id(dem[k], *xyz) for k in dem}
-    sub = {k: by_id(recorded[k], *xyz) for k in recorded}
+    ref = {k: positions(dem[k]) for k in dem}
+    sub = {k: positions(recorded[k]) for k in recorded}
     # the recorded periods per revolution: the snapshot that is the reference's t1
     per_revolution = next((k for k in sorted(sub) if k > 0 and np.array_equal(sub[k], ref[1])),
                           None)
@@ -78,7 +77,7 @@ def main(ref_path, rec_path, extra_paths):
     reference = [tilt(ref[k], t1_temp) for k in ks]
 
     def to_reference(tilts):
-        return [distance(a, b) for a, b in zip(tilts, reference)]
+        return [tilt_distance(a, b) for a, b in zip(tilts, reference)]
 
     pairings = {}
 
@@ -118,7 +117,7 @@ def main(ref_path, rec_path, extra_paths):
           f"conduction; slab tilts' distance to the reference's at t{ks[0]}…t{ks[-1]} "
           f"(K per {SLAB_D} d)")
     for m, twin in enumerate(twins):
-        tilts = [tilt(by_id(twin[k], *xyz), t1_temp) for k in ks]
+        tilts = [tilt(positions(twin[k]), t1_temp) for k in ks]
         print(f"  twin {m + 1}: {row(to_reference(tilts))}")
     out, jumps = play(lambda at, rng: 1 if at == per_revolution else at + 1, None)
     print(f"  the revolution as one period (the paper's method): {row(out)}; {jumps} jumps")
@@ -138,17 +137,19 @@ def main(ref_path, rec_path, extra_paths):
               f"max {row(dist.max(0))}; {np.mean([j for _, j in runs]):.1f} jumps")
     # the real extrapolations (with conduction) at the same instants: their snapshot
     # per_revolution·k is the revolution k after t0, the reference's t_k
+    def own_tilt(points):
+        """A run's tilts with its own temperatures (conduction and all)."""
+        return tilt(positions(points), by_id(points, "T"))
+
+    if extra_paths:
+        measured_ref = {k: own_tilt(dem[k]) for k in ks}
+        measured_twin = {k: tilt_distance(own_tilt(twins[0][k]), measured_ref[k]) for k in ks}
     for path in extra_paths:
         extra = by_topic(path)["/tdex/snapshots"]
         at_k = {k: extra[per_revolution * k] for k in ks if per_revolution * k in extra}
-        measured = [distance(tilt(by_id(dem[k], *xyz), by_id(dem[k], "T")),
-                             plain_tilts(np.stack([p[a] for a in xyz], 1), p["T"], width, slabs,
-                                         per)) for k, p in at_k.items()]
-        twin_measured = [distance(tilt(by_id(dem[k], *xyz), by_id(dem[k], "T")),
-                                  tilt(by_id(twins[0][k], *xyz), by_id(twins[0][k], "T")))
-                         for k in at_k]
+        measured = [tilt_distance(own_tilt(p), measured_ref[k]) for k, p in at_k.items()]
         print(f"  measured, with conduction, at t{min(at_k)}…t{max(at_k)}: {path} "
-              f"{row(measured)}; twin 1 {row(twin_measured)}")
+              f"{row(measured)}; twin 1 {row(measured_twin[k] for k in at_k)}")
 
 
 if __name__ == "__main__":

@@ -16,11 +16,7 @@ import sys
 
 import numpy as np
 
-from spread import by_id, by_topic, dem_runs, diameter
-
-
-def positions(points):
-    return by_id(points, "x", "y", "z")
+from spread import by_topic, dem_runs, diameter, positions
 
 
 def main(rec_path, extra_path):

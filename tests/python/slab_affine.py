@@ -45,18 +45,14 @@ import sys
 import numpy as np
 import scipy.sparse as sp
 
-from slab_corrected import MIN_FIT, slab_fits
-from spread import axial_slab, by_id, by_topic, dem_runs, diameter, hot_at_t0, run_names
+from slab_corrected import MIN_FIT, fits_per_slab, slab_fits, tilt_distance as distance
+from spread import (axial_slab, by_id, by_topic, dem_runs, diameter, hot_at_t0, positions,
+                    run_names)
 
 # tilts are printed per 10 diameters whatever the slab width, as slab_corrected.py's
 TILT_D = 10
 # random orders of distinct DEM revolutions: enough draws for a mean and a max
 DRAWS = 20
-
-
-def positions(points):
-    """x, y, z in particle-id order (one row per id)."""
-    return by_id(points, "x", "y", "z")
 
 
 def poly_basis(xz, scale, degree):
@@ -76,9 +72,8 @@ def back_map(start, end, slab_of_end, slabs, scale, degree=1):
     it had where they came from, so for degree 1 a tilt g becomes A^T g, A the coefficient
     block of x and z ({slab: coefficients, rows the basis, columns x_k, z_k; both sides in
     units of `scale`})."""
-    return {s: np.linalg.lstsq(poly_basis(end[slab_of_end == s][:, [0, 2]], scale, degree),
-                               start[slab_of_end == s][:, [0, 2]] / scale, rcond=None)[0]
-            for s in slabs}
+    return fits_per_slab(slab_of_end, poly_basis(end[:, [0, 2]], scale, degree),
+                         start[:, [0, 2]] / scale, slabs)
 
 
 def linear_part(coefs):
@@ -89,13 +84,9 @@ def linear_part(coefs):
 def plain_tilts(pos, values, width, slabs, per):
     """Per slab, the x and z slopes of the least-squares fit of `values` on [1, x, z], per `per`
     metres (the temperature field's tilt with no group term: the one advection carries)."""
-    slab = axial_slab(pos[:, 1], width)
-    out = []
-    for s in slabs:
-        rows = slab == s
-        basis = np.stack([np.ones(rows.sum()), pos[rows, 0], pos[rows, 2]], 1)
-        out.append(np.linalg.lstsq(basis, values[rows], rcond=None)[0][1:] * per)
-    return np.array(out)
+    basis = np.stack([np.ones(len(pos)), pos[:, 0], pos[:, 2]], 1)
+    fits = fits_per_slab(axial_slab(pos[:, 1], width), basis, values, slabs)
+    return np.array([fits[s][1:] * per for s in slabs])
 
 
 def hot_cold_tilts(points, hot_by_id, width, slabs, per):
@@ -103,11 +94,6 @@ def hot_cold_tilts(points, hot_by_id, width, slabs, per):
     slopes per `per` metres (the tilt the docs' table gives)."""
     fits = slab_fits(points, hot_by_id, width)[2]
     return np.array([fits[s][1] for s in slabs]), np.array([fits[s][2:] * per for s in slabs])
-
-
-def distance(a, b):
-    """The rms over the slabs of the tilt vectors' difference."""
-    return float(np.sqrt(np.mean(np.sum((np.asarray(a) - np.asarray(b)) ** 2, axis=-1))))
 
 
 def row(values, fmt="{:.3f}"):
@@ -397,11 +383,12 @@ def main(rec_path, extra_path, slab_d, cell_d):
     print("  the recorded revolution and its mirror image in turn (--mirror): "
           f"{row(to_b(cells_from_t1([recorded] * n_per, t_values, mirrored, mirrored_geometry)))}")
 
-    def corrected(step, degree, target):
-        """The step's transport with each slab's back-map polynomial (up to `degree`) replaced
-        by `target`'s, the particles' departures from it kept: start + basis (target - own)."""
+    def corrected(step, degree, own, target):
+        """The step's transport with each slab's back-map polynomial (up to `degree`, `own` the
+        step's fit) replaced by `target`'s, the particles' departures from it kept: start +
+        basis (target - own)."""
         start, end = ends[step]
-        own, moved = fits(step, degree), start.copy()
+        moved = start.copy()
         for s in slabs:
             rows = end_slab[step] == s
             moved[np.ix_(rows, [0, 2])] += width * (
@@ -430,8 +417,9 @@ def main(rec_path, extra_path, slab_d, cell_d):
         mean_fit = {b: np.mean([per_step[o][b] for o in others], 0) for b in slabs}
 
         def with_fit(sequence, target):
-            return to_b(cells_from_t1(sequence, t_values,
-                                      [corrected(s, degree, target) for s in sequence]))
+            # each distinct revolution's corrected transport once (the replay's repeats one)
+            mats = {s: corrected(s, degree, per_step[s], target) for s in set(sequence)}
+            return to_b(cells_from_t1(sequence, t_values, [mats[s] for s in sequence]))
 
         print(f"    degree {degree}: the replay's map set to the DEM mean, repeated "
               f"{row(with_fit([replay] * n_per, mean_fit))}")

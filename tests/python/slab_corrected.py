@@ -56,6 +56,17 @@ def with_slab_means(run, reference, hot_by_id, width):
     return out
 
 
+def fits_per_slab(slab, basis, values, slabs=None):
+    """{slab: least-squares coefficients of `values` on the `basis` rows of its particles}, for
+    the given slabs, or for every slab of at least MIN_FIT particles (the end caps' slivers
+    left out)."""
+    if slabs is None:
+        found, counts = np.unique(slab, return_counts=True)
+        slabs = found[counts >= MIN_FIT]
+    return {s: np.linalg.lstsq(basis[slab == s], values[slab == s], rcond=None)[0]
+            for s in slabs}
+
+
 def slab_fits(points, hot_by_id, width):
     """Per axial slab, the least-squares fit of the temperatures on [1, hot, x, z]: the slab's
     cold mean, its hot-cold contrast and the tilt of its field across the drum (K/m along x
@@ -65,12 +76,13 @@ def slab_fits(points, hot_by_id, width):
     slab = axial_slab(points["y"], width)
     basis = np.stack([np.ones(len(points)), hot_by_id[points["id"]].astype(float),
                       points["x"], points["z"]]).T
-    fits = {}
-    for s in np.unique(slab):
-        rows = slab == s
-        if rows.sum() >= MIN_FIT:
-            fits[s] = np.linalg.lstsq(basis[rows], points["T"][rows], rcond=None)[0]
-    return slab, basis, fits
+    return slab, basis, fits_per_slab(slab, basis, points["T"])
+
+
+def tilt_distance(a, b):
+    """The rms over the slabs of the difference of two runs' slab tilts (one x, z vector per
+    slab, the slabs in the same order)."""
+    return float(np.sqrt(np.mean(np.sum((np.asarray(a) - np.asarray(b)) ** 2, axis=-1))))
 
 
 def with_slab_fits(run, reference, hot_by_id, width):
@@ -94,9 +106,8 @@ def tilts(runs, hot_by_id, width, d):
     per_run = [slab_fits(r, hot_by_id, width)[2] for r in runs]
     slabs = sorted(set.intersection(*(set(f) for f in per_run)))
     vecs = [np.array([f[s][2:] for s in slabs]) * 10 * d for f in per_run]
-    return [(np.linalg.norm(v.mean(axis=0)),
-             np.sqrt(np.mean(np.sum((v - v.mean(axis=0)) ** 2, axis=1))),
-             np.sqrt(np.mean(np.sum((v - vecs[0]) ** 2, axis=1)))) for v in vecs]
+    return [(np.linalg.norm(v.mean(axis=0)), tilt_distance(v, v.mean(axis=0)),
+             tilt_distance(v, vecs[0])) for v in vecs]
 
 
 def main(rec_path, extra_path, slab_d, edge_d):

@@ -26,13 +26,10 @@ import sys
 import numpy as np
 from scipy.spatial import cKDTree
 
-from spread import axial_slab, by_id, by_topic, compared_ks, dem_runs, diameter, hot_at_t0, run_names
+from spread import (axial_slab, by_id, by_topic, compared_ks, dem_runs, diameter, hot_at_t0,
+                    positions, run_names)
 
 TOUCH = 1.05  # contact: centres within this many diameters
-
-
-def positions(points):
-    return by_id(points, "x", "y", "z")
 
 
 def main(rec_path, extra_path, slab_d):

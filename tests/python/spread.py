@@ -72,6 +72,11 @@ def by_id(points, *fields):
     return out[:, 0] if len(fields) == 1 else out
 
 
+def positions(points):
+    """x, y, z in particle-id order (one row per id)."""
+    return by_id(points, "x", "y", "z")
+
+
 def well_filled(cells):
     """The keys of a {key: (mean, count)} map whose cells hold at least half the median count:
     the thin cells at the bed's surface and walls are mostly sampling noise."""
