@@ -36,8 +36,10 @@ use super::sparse_lap::Lap;
 /// `AUCTION_PAIRS_PER_ROW` in the parent module.)
 pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree (at most 64: a leaf's hits are the bits of a
-/// `u64`, [`WeightedTree::leaf_hits`]).
-const LEAF: usize = 32;
+/// `u64`, [`WeightedTree::leaf_hits`]). 32 until the leaves' test lost its branches;
+/// since then 64 visits fewer nodes for the same points found, 8 % less time in the
+/// certificate on the long kiln (docs/benchmarks.md, eighteenth session).
+const LEAF: usize = 64;
 const _: () = assert!(LEAF <= 64);
 /// Relative safety margin on `R_p` and the bounds: floating-point distances and the
 /// conversion of potentials to lengths err by ~1e-16 relative, far below this.
