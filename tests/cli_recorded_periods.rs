@@ -380,3 +380,97 @@ fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
         assert!(Path::new(p["pairing_file"].as_str().unwrap()).exists());
     }
 }
+
+/// An extrapolation of several recorded periods is the recorded run itself until its first
+/// jump (t2 … tP'): `tdex compare` shows those t_k, in parentheses, but leaves them out of
+/// the verdict, whose median they would only flatter; the paper's method (one period)
+/// leaves nothing out.
+#[test]
+fn the_verdict_leaves_out_the_recorded_stretch() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let rec = dir.path().join("p2.mcap");
+    record(
+        &case,
+        &rec,
+        &[
+            "--recorded-periods",
+            "2",
+            "--reference",
+            "4",
+            "--twins",
+            "1",
+        ],
+    );
+    let (x2, x1) = (dir.path().join("x2.mcap"), dir.path().join("x1.mcap"));
+    // t2 (the recording's own second period), then t3, t4 after jumps
+    let path = extrapolate(&rec, &x2, "3", &["--jump-to", "2"]);
+    assert_eq!(path["path"]["replayed"], serde_json::json!([2, 2, 2]));
+    extrapolate(&rec, &x1, "3", &["--recorded-periods", "1"]);
+    let compare = |x: &Path| -> serde_json::Value {
+        serde_json::from_str(&tdex_ok(&[
+            "compare",
+            rec.to_str().unwrap(),
+            x.to_str().unwrap(),
+            "--cells",
+            "20",
+            "--json",
+        ]))
+        .unwrap()
+    };
+    let ks = |v: &serde_json::Value, key: &str| -> Vec<u64> {
+        v["verdict"][key]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|k| k.as_u64().unwrap())
+            .collect()
+    };
+
+    let v = compare(&x2);
+    let periods = v["periods"].as_array().unwrap();
+    let within: Vec<(u64, bool)> = periods
+        .iter()
+        .map(|p| {
+            let k = p["k"].as_u64().unwrap();
+            (k, p["within_recording"].as_bool().unwrap())
+        })
+        .collect();
+    assert_eq!(within, [(2, true), (3, false), (4, false)], "{v}");
+    // at t2 the extrapolation is the DEM's own snapshot: a tiny distance to it
+    assert!(periods[0]["eps_abs"].as_f64().unwrap() < 1e-3, "{v}");
+    assert_eq!(ks(&v, "within_recording"), [2]);
+    assert_eq!(ks(&v, "compared"), [3, 4]);
+    let judged: Vec<f64> = periods[1..]
+        .iter()
+        .map(|p| p["ratio_to_floor"].as_f64().unwrap())
+        .collect();
+    let median = 0.5 * (judged[0] + judged[1]);
+    assert!(
+        (v["verdict"]["median_ratio"].as_f64().unwrap() - median).abs() < 1e-12,
+        "{v}"
+    );
+    let text = v["verdict"]["text"].as_str().unwrap();
+    assert!(text.contains("over t3, t4"), "{text}");
+    assert!(
+        text.contains("t2 left out, where the extrapolation is still the recorded run"),
+        "{text}"
+    );
+    let table = tdex_ok(&[
+        "compare",
+        rec.to_str().unwrap(),
+        x2.to_str().unwrap(),
+        "--cells",
+        "20",
+    ]);
+    let t2 = table
+        .lines()
+        .find(|l| l.trim_start().starts_with("2 "))
+        .unwrap();
+    assert!(t2.contains(" ("), "t2's ratio in parentheses: {table}");
+
+    // one recorded period: every t_k is the extrapolation's own
+    let v = compare(&x1);
+    assert!(ks(&v, "within_recording").is_empty(), "{v}");
+    assert_eq!(ks(&v, "compared"), [2, 3, 4]);
+}

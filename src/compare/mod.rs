@@ -109,6 +109,11 @@ pub struct PeriodComparison {
     pub dem_runs_hot_mean: Vec<f64>,
     pub dem_runs_cold_mean: Vec<f64>,
     pub dem_runs_bed_mean: Vec<f64>,
+    /// The extrapolation had not yet left the recorded run at this `t_k`: along a
+    /// recurrence path the periods before the first jump are the recording's own
+    /// continuation from `t1` (`t2 … tP'` with `P'` recorded periods), so its snapshot is
+    /// the DEM's own. Shown, but left out of the verdict, whose median it would only flatter.
+    pub within_recording: bool,
 }
 
 impl PeriodComparison {
@@ -264,8 +269,16 @@ pub fn compare_runs(
         check_same_instants((recording, &dem), (run, &snaps))?;
         others.push(snaps);
     }
+    // The last snapshot index that is still the recorded run's (0: none, a second DEM run).
+    let mut recorded_until = 0u32;
     let (extra_path, extra, kind, own_groups) = match second {
         Second::Extrapolation(extrapolation) => {
+            // periods 1 … j − 1 before the first jump j end at t2 … t_j
+            recorded_until = extrapolation
+                .info()
+                .roles
+                .first_jump()
+                .map_or(u32::MAX, |j| u32::try_from(j).unwrap_or(u32::MAX));
             let extra_path = extrapolation.path().display().to_string();
             let own = &extrapolation.info().recording_info;
             if own != recording.info() && !same_run(own, recording.info()) {
@@ -506,6 +519,7 @@ pub fn compare_runs(
                 .iter()
                 .map(|s| metrics::bed_mean(&s.radius, &s.temp))
                 .collect(),
+            within_recording: after.index <= recorded_until,
         });
     }
     if periods.is_empty() {
@@ -676,7 +690,13 @@ pub fn table(c: &Comparison) -> String {
                 " {:>9} {:>9} {:>6}",
                 opt(p.floor_eps_abs, 1.0, 5),
                 opt(p.floor_eps_abs_max, 1.0, 5),
-                p.ratio_to_floor.map_or("-".into(), verdict::num)
+                p.ratio_to_floor
+                    .map_or("-".into(), |r| if p.within_recording {
+                        // the recorded run itself: shown, left out of the verdict
+                        format!("({})", verdict::num(r))
+                    } else {
+                        verdict::num(r)
+                    })
             );
         }
         if groups {
@@ -707,11 +727,11 @@ pub fn table(c: &Comparison) -> String {
 pub fn csv(c: &Comparison) -> String {
     let f = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v:e}"));
     let mut s = String::from(
-        "k,t,eps_abs,eps_rel,energy_error,cells_used,hot_mean_dem,hot_mean_extra,cold_mean_dem,cold_mean_extra,bed_mean_dem,bed_mean_extra,floor_eps_abs,floor_eps_abs_max,floor_eps_rel,ratio_to_floor\n",
+        "k,t,eps_abs,eps_rel,energy_error,cells_used,hot_mean_dem,hot_mean_extra,cold_mean_dem,cold_mean_extra,bed_mean_dem,bed_mean_extra,floor_eps_abs,floor_eps_abs_max,floor_eps_rel,ratio_to_floor,within_recording\n",
     );
     for p in &c.periods {
         s += &format!(
-            "{},{:e},{:e},{},{},{},{},{},{},{},{:e},{:e},{},{},{},{}\n",
+            "{},{:e},{:e},{},{},{},{},{},{},{},{:e},{:e},{},{},{},{},{}\n",
             p.k,
             p.t,
             p.eps_abs,
@@ -727,7 +747,8 @@ pub fn csv(c: &Comparison) -> String {
             f(p.floor_eps_abs),
             f(p.floor_eps_abs_max),
             f(p.floor_eps_rel),
-            f(p.ratio_to_floor)
+            f(p.ratio_to_floor),
+            p.within_recording
         );
     }
     s

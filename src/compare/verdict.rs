@@ -15,8 +15,11 @@ pub struct Verdict {
     pub median_ratio: Option<f64>,
     pub ratio_min: Option<f64>,
     pub ratio_max: Option<f64>,
-    /// The `t_k` with a ratio.
+    /// The `t_k` with a ratio, the extrapolation's own (not `within_recording`).
     pub compared: Vec<u32>,
+    /// The `t_k` left out because the extrapolation was still the recorded run there
+    /// (`t2 … tP'` of a recurrence path, before its first jump).
+    pub within_recording: Vec<u32>,
     /// The `t_k` where the second field's mean distance to the DEM runs exceeds the largest
     /// distance between two of them (with two DEM runs: the `t_k` with a ratio above 1,
     /// which do not fail it, see [`Verdict::of`]).
@@ -94,8 +97,17 @@ impl Verdict {
     /// DEM runs (one twin) the range is one distance per `t_k`, so staying within it at
     /// every `t_k` would be a ratio ≤ 1 at every `t_k`, which a method identical to the DEM
     /// in law misses at about half of them: the median alone decides, and the `t_k` above
-    /// 1 are named.
+    /// 1 are named. The `t_k` where the extrapolation was still the recorded run
+    /// ([`PeriodComparison::within_recording`]) are left out: there it is the DEM itself.
     pub fn of(periods: &[PeriodComparison], dem_runs: usize, contrast: ContrastKind) -> Self {
+        let within_recording: Vec<u32> = periods
+            .iter()
+            .filter(|p| p.within_recording)
+            .map(|p| p.k)
+            .collect();
+        let floors = periods.iter().any(|p| p.floor_eps_abs.is_some());
+        let periods: Vec<&PeriodComparison> =
+            periods.iter().filter(|p| !p.within_recording).collect();
         let rated: Vec<(u32, f64)> = periods
             .iter()
             .filter_map(|p| Some((p.k, p.ratio_to_floor?)))
@@ -112,7 +124,7 @@ impl Verdict {
         let groups = contrast == ContrastKind::HotCold;
         let mut error: Option<f64> = None;
         let mut spread: Option<f64> = None;
-        for p in periods {
+        for p in &periods {
             let pairs: Vec<(f64, f64, &Vec<f64>)> = if groups {
                 [
                     (p.hot_mean_extra, p.hot_mean_dem, &p.dem_runs_hot_mean),
@@ -135,7 +147,6 @@ impl Verdict {
             }
         }
         let median_ratio = median(&ratios);
-        let floors = periods.iter().any(|p| p.floor_eps_abs.is_some());
         let one_pair = dem_runs == 2;
         let passes = median_ratio.map(|m| m <= 1.0 && (one_pair || outside_range.is_empty()));
         let what = if groups { "group means" } else { "bed mean" };
@@ -157,10 +168,19 @@ impl Verdict {
         } else {
             ratios.first().map_or(String::new(), |r| num(*r))
         };
+        // the recorded span, named so that a reader knows why the verdict starts later
+        let left_out = if within_recording.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} left out, where the extrapolation is still the recorded run",
+                instants(&within_recording, within_recording.len())
+            )
+        };
         let text = match (passes, median_ratio) {
             (Some(true), Some(m)) => format!(
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{means}",
+                 theirs to each other over {} (median {}), {}{left_out}{means}",
                 instants(&compared, compared.len()),
                 num(m),
                 if outside_range.is_empty() {
@@ -203,7 +223,7 @@ impl Verdict {
                 };
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{means}",
+                     each other over {} (median {}){beyond}{few}{left_out}{means}",
                     instants(&compared, compared.len()),
                     if m > 1.0 {
                         format!("{} > 1", above_one(m))
@@ -212,6 +232,12 @@ impl Verdict {
                     },
                 )
             }
+            _ if floors && compared.is_empty() && !within_recording.is_empty() => format!(
+                "not judged: at every compared t_k ({}) the extrapolation is still the recorded \
+                 run, which it follows until its first jump through a pairing; compare t_k past \
+                 the recorded periods{means}",
+                instants(&within_recording, within_recording.len())
+            ),
             _ if floors => format!(
                 "the {dem_runs} DEM runs are identical at every compared t_k (floor 0): there \
                  is no spread to judge the extrapolation against{means}"
@@ -228,6 +254,7 @@ impl Verdict {
             ratio_min: (!ratios.is_empty()).then_some(lo),
             ratio_max: (!ratios.is_empty()).then_some(hi),
             compared,
+            within_recording,
             outside_range,
             means_error_max: error,
             means_spread_max: spread,
@@ -268,6 +295,7 @@ mod tests {
             dem_runs_hot_mean: vec![310.04],
             dem_runs_cold_mean: vec![300.01],
             dem_runs_bed_mean: vec![305.0],
+            within_recording: false,
         }
     }
 
@@ -303,6 +331,32 @@ mod tests {
         assert_eq!(v.passes, Some(true));
         assert!(
             v.text.contains("never beyond the farthest two"),
+            "{}",
+            v.text
+        );
+    }
+
+    /// The t_k where the extrapolation is still the recorded run are left out of the
+    /// verdict (and named); with nothing else left, nothing is judged.
+    #[test]
+    fn the_recorded_stretch_is_left_out() {
+        let mut periods: Vec<PeriodComparison> = [0.5, 1.02, 1.04, 0.9]
+            .iter()
+            .zip(2..)
+            .map(|(&r, k)| period(k, r, 1.0))
+            .collect();
+        periods[0].within_recording = true;
+        let v = Verdict::of(&periods, 2, ContrastKind::HotCold);
+        assert_eq!(v.within_recording, vec![2]);
+        assert_eq!(v.compared, vec![3, 4, 5]);
+        assert_eq!(v.median_ratio, Some(1.02));
+        assert_eq!(v.passes, Some(false), "{}", v.text);
+        assert!(v.text.contains("over t3…t5"), "{}", v.text);
+        assert!(v.text.contains("t2 left out"), "{}", v.text);
+        let v = Verdict::of(&periods[..1], 2, ContrastKind::HotCold);
+        assert_eq!(v.passes, None);
+        assert!(
+            v.text.starts_with("not judged: at every compared t_k (t2)"),
             "{}",
             v.text
         );

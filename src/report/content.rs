@@ -683,7 +683,17 @@ fn errors_section(d: &mut Document, c: &Comparison) {
         ),
         (
             "Ratio to floor",
-            Box::new(|p| p.ratio_to_floor.map(|v| sig(v, 3))),
+            // in parentheses where the extrapolation is still the recorded run (left out of
+            // the verdict)
+            Box::new(|p| {
+                p.ratio_to_floor.map(|v| {
+                    if p.within_recording {
+                        format!("({})", sig(v, 3))
+                    } else {
+                        sig(v, 3)
+                    }
+                })
+            }),
         ),
         (
             "Eq. 10 energy error (%)",

@@ -142,6 +142,17 @@ impl Roles {
         }
     }
 
+    /// The first extrapolated period (1-based) entered through a pairing: 1 for the
+    /// paper's method; along a recurrence path the first jump (the periods before it are
+    /// the recording's own continuation from `t1`, so the snapshots up to it are the
+    /// recorded run's); `None` for a path that never jumped.
+    pub fn first_jump(&self) -> Option<usize> {
+        match self {
+            Roles::Pairing(_) => Some(1),
+            Roles::Path(path) => path.entered_by_jump().position(|jump| jump).map(|k| k + 1),
+        }
+    }
+
     /// The recorded periods the extrapolation replayed, `P'` (1 through a pairing).
     pub fn recorded_periods_used(&self) -> u32 {
         match self {
@@ -435,7 +446,28 @@ impl ExtrapolationReader {
 
 #[cfg(test)]
 mod tests {
-    use super::Symmetry;
+    use super::{RecurrencePath, Roles, Symmetry};
+
+    /// The snapshots before the first jump are the recorded run's own: the path leaves the
+    /// recording at its first period entered through a pairing.
+    #[test]
+    fn a_path_leaves_the_recording_at_its_first_jump() {
+        let path = |replayed: Vec<u32>| {
+            Roles::Path(RecurrencePath {
+                recorded_periods: 3,
+                seed: 0,
+                jump_targets: None,
+                replayed,
+                pairings: Vec::new(),
+            })
+        };
+        // from t1, periods 2 and 3 follow the recording; the fourth period jumps
+        assert_eq!(path(vec![2, 3, 1, 2]).first_jump(), Some(3));
+        assert_eq!(path(vec![2, 2, 3]).first_jump(), Some(2));
+        // period 1 again right after t1 is a jump (through the pairing of t1 to t0)
+        assert_eq!(path(vec![1, 2, 3]).first_jump(), Some(1));
+        assert_eq!(path(vec![2, 3]).first_jump(), None);
+    }
 
     #[test]
     fn the_mirror_image_negates_y_and_nothing_else() {
