@@ -437,8 +437,13 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
         })
         .collect();
     assert_eq!(within, [(2, true), (3, false), (4, false)], "{v}");
-    // at t2 the extrapolation is the DEM's own snapshot: a tiny distance to it
+    // at t2 the extrapolation is the DEM's own snapshot: a tiny distance to it; and it is
+    // measured to the twin alone (the reference is its own past), so there it is as far
+    // from the twin as the reference is: a ratio of 1, where the mean over both runs would
+    // give 0.5
     assert!(periods[0]["eps_abs"].as_f64().unwrap() < 1e-3, "{v}");
+    let ratio_t2 = periods[0]["ratio_to_floor"].as_f64().unwrap();
+    assert!((ratio_t2 - 1.0).abs() < 0.05, "{v}");
     assert_eq!(ks(&v, "within_recording"), [2]);
     assert_eq!(ks(&v, "compared"), [3, 4]);
     let judged: Vec<f64> = periods[1..]
@@ -469,8 +474,16 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
         .unwrap();
     assert!(t2.contains(" ("), "t2's ratio in parentheses: {table}");
 
-    // one recorded period: every t_k is the extrapolation's own
+    // one recorded period: every t_k is the extrapolation's own, measured to both runs
     let v = compare(&x1);
     assert!(ks(&v, "within_recording").is_empty(), "{v}");
     assert_eq!(ks(&v, "compared"), [2, 3, 4]);
+    for p in v["periods"].as_array().unwrap() {
+        let (e, to_runs) = (
+            p["eps_abs"].as_f64().unwrap(),
+            p["eps_abs_to_dem_runs"].as_f64().unwrap(),
+        );
+        // the mean of its distances to the reference and to the twin
+        assert!(to_runs >= 0.5 * e - 1e-12, "{p}");
+    }
 }

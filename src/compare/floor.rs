@@ -15,7 +15,7 @@ pub struct Floor {
     pub floor_eps_abs_max: f64,
     /// Pairs of DEM runs measured.
     pub floor_pairs: usize,
-    /// The extrapolation's mean `ε_abs` (K) to the DEM runs.
+    /// The extrapolation's mean `ε_abs` (K) to the DEM runs (see [`Against`]).
     pub eps_abs_to_dem_runs: f64,
     /// `eps_abs_to_dem_runs / floor_eps_abs`; absent when the DEM runs are identical
     /// (floor 0): nothing to judge against, not an infinite ratio.
@@ -34,10 +34,30 @@ pub struct Field<'a> {
     pub temp: &'a [f64],
 }
 
-/// The floor of `runs` (at least two DEM runs at the same `t_k`) and the distance of
-/// `second` (cell means already computed) to them, on `cells`. `None` with fewer than two
-/// runs or when no cell holds particles of both fields of some pair.
-pub fn floor(cells: &Cells, runs: &[Field], second: &[Option<f64>]) -> Option<Floor> {
+/// Which DEM runs the second field's distance is measured to: those that parted from its
+/// past as early as they parted from each other.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Against {
+    /// All of them: an extrapolation that leaves the reference at `t1`, where the twins do,
+    /// or a second DEM run.
+    AllRuns,
+    /// All but the reference (the first run): an extrapolation of several recorded periods
+    /// is the reference itself until its first jump, so its distance to the reference has
+    /// had less time to grow than the runs' distances to each other, which would flatter it.
+    /// The twins parted from that shared past at `t1`, as from each other.
+    AllButTheReference,
+}
+
+/// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
+/// the distance of `second` (cell means already computed) to those `against` names, on
+/// `cells`. `None` with fewer than two runs or when no cell holds particles of both fields
+/// of some pair.
+pub fn floor(
+    cells: &Cells,
+    runs: &[Field],
+    second: &[Option<f64>],
+    against: Against,
+) -> Option<Floor> {
     if runs.len() < 2 {
         return None;
     }
@@ -48,7 +68,11 @@ pub fn floor(cells: &Cells, runs: &[Field], second: &[Option<f64>]) -> Option<Fl
             pairs.push(eps_abs(a, b)?.0);
         }
     }
-    let to_runs = means
+    let skip = match against {
+        Against::AllRuns => 0,
+        Against::AllButTheReference => 1,
+    };
+    let to_runs = means[skip..]
         .iter()
         .map(|m| eps_abs(m, second).map(|(e, _)| e))
         .collect::<Option<Vec<f64>>>()?;
@@ -104,7 +128,7 @@ mod tests {
             temp: &temp,
         };
         let extra = [Some(16.0), Some(35.0)];
-        let f = floor(&cells(), &[dem, twin], &extra).unwrap();
+        let f = floor(&cells(), &[dem, twin], &extra, Against::AllRuns).unwrap();
         assert_eq!(f.floor_eps_abs, 0.0);
         assert_eq!(f.floor_eps_abs_max, 0.0);
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
@@ -128,19 +152,36 @@ mod tests {
             },
         ];
         // the extrapolation halfway between them: 0.5 K from each
-        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)]).unwrap();
+        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)], Against::AllRuns).unwrap();
         assert_eq!(f.floor_eps_abs, 1.0);
         assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         assert_eq!(f.ratio_to_floor, Some(0.5));
         assert!(within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
         // a field 3 K off in the first cell is farther than the runs are from each other
-        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)]).unwrap();
+        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)], Against::AllRuns).unwrap();
         assert_eq!(far.eps_abs_to_dem_runs, 1.5);
         assert_eq!(far.ratio_to_floor, Some(1.5));
         assert!(!within(far.eps_abs_to_dem_runs, far.floor_eps_abs_max));
         // one run alone has no floor
-        assert_eq!(floor(&cells(), &runs[..1], &[Some(15.0), Some(35.0)]), None);
+        assert_eq!(
+            floor(
+                &cells(),
+                &runs[..1],
+                &[Some(15.0), Some(35.0)],
+                Against::AllRuns
+            ),
+            None
+        );
+        // the field of the DEM itself (an extrapolation still on the reference): half the
+        // floor to both runs, the whole floor to the twin alone
+        let on_dem = [Some(15.0), Some(35.0)];
+        let all = floor(&cells(), &runs, &on_dem, Against::AllRuns).unwrap();
+        assert_eq!(all.ratio_to_floor, Some(0.5));
+        let twins = floor(&cells(), &runs, &on_dem, Against::AllButTheReference).unwrap();
+        assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
+        assert_eq!(twins.ratio_to_floor, Some(1.0));
+        assert_eq!(twins.floor_eps_abs, all.floor_eps_abs);
     }
 
     #[test]

@@ -97,6 +97,8 @@ pub struct PeriodComparison {
     /// The DEM's own spread (null with a single DEM run): the mean, smallest and largest
     /// `ε_abs` between two DEM runs, the mean relative to `contrast`, the second field's mean
     /// `ε_abs` to the DEM runs and its ratio to the mean floor (null when the floor is 0).
+    /// An extrapolation of several recorded periods, the reference itself until its first
+    /// jump, is measured to the other runs only ([`floor::Against`]).
     pub floor_eps_abs: Option<f64>,
     pub floor_eps_abs_min: Option<f64>,
     pub floor_eps_abs_max: Option<f64>,
@@ -395,6 +397,14 @@ pub fn compare_runs(
     // same run (another period τ, more recorded periods) the reference t_k it lands on; its
     // snapshots between two reference instants are skipped, and each compared one is measured
     // over the stretch since the last compared one (t_{k−1} → t_k).
+    // An extrapolation that follows the reference past t1 (several recorded periods) is
+    // measured against the runs that parted from that shared past at t1: the twins and any
+    // further runs, not the reference (floor::Against).
+    let against = if recorded_until >= 2 {
+        floor::Against::AllButTheReference
+    } else {
+        floor::Against::AllRuns
+    };
     let half_step = 0.5 * recording.info().dt;
     let dem_index_at = |time: f64| {
         dem.iter()
@@ -460,7 +470,7 @@ pub fn compare_runs(
                 temp: &s.temp,
             })
             .collect();
-        let floor = floor::floor(&cells_v, &runs, &extra_means);
+        let floor = floor::floor(&cells_v, &runs, &extra_means, against);
         // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
         // has no snapshot at t1, where it is the reference
         let floor_energy_error = others

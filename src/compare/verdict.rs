@@ -46,6 +46,20 @@ pub(crate) fn num(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// A median ratio with the decimals that put it on its side of 1 (`0.997`, not `1`, for
+/// a median that passes; `1.004` for one that does not).
+fn beside_one(x: f64) -> String {
+    if x > 1.0 {
+        return above_one(x);
+    }
+    let mut decimals = 2;
+    while decimals < 6 && x < 1.0 && format!("{x:.decimals$}").parse::<f64>().unwrap_or(x) >= 1.0 {
+        decimals += 1;
+    }
+    let s = format!("{x:.decimals$}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 /// A ratio said to exceed 1, with the decimals that show it does (`1.004`, not `1`).
 fn above_one(x: f64) -> String {
     let mut decimals = 2;
@@ -182,7 +196,7 @@ impl Verdict {
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
                  theirs to each other over {} (median {}), {}{left_out}{means}",
                 instants(&compared, compared.len()),
-                num(m),
+                beside_one(m),
                 if outside_range.is_empty() {
                     "never beyond the farthest two".to_string()
                 } else {
@@ -385,6 +399,10 @@ mod tests {
         assert_eq!(num(1.0), "1");
         assert_eq!(above_one(1.0015), "1.002");
         assert_eq!(above_one(1.18), "1.18");
+        assert_eq!(beside_one(0.9968), "0.997");
+        assert_eq!(beside_one(0.96), "0.96");
+        assert_eq!(beside_one(1.0), "1");
+        assert_eq!(beside_one(1.0015), "1.002");
         assert_eq!(num(12.34), "12.3");
         assert_eq!(num(55769240392.9), "5.6e10");
         assert_eq!(kelvin(0.0812), "0.0812 K");
