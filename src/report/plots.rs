@@ -839,7 +839,8 @@ pub fn errors(c: &Comparison) -> Result<String> {
         let abs = by_k(|p| Some(p.eps_abs));
         let to_runs = by_k(|p| p.eps_abs_to_dem_runs);
         // with two DEM runs there is one distance between them, no range: the band is then
-        // what passes at each t_k, from 0 up to that distance
+        // from 0 up to that distance (a point above it is a ratio above 1 there, which the
+        // verdict allows at some t_k: with one twin its median decides)
         let one_pair = c.dem_runs == 2;
         let band: Vec<(f64, f64, f64)> = c
             .periods
