@@ -387,6 +387,15 @@ pub fn compare_runs(
         (None, None) => ContrastKind::None,
     };
 
+    // An extrapolation that follows the reference past t1 (several recorded periods) is
+    // measured against the runs that parted from that shared past at t1: the twins and any
+    // further runs, not the reference (floor::Against).
+    let against = if recorded_until >= 2 {
+        floor::Against::AllButTheReference
+    } else {
+        floor::Against::AllRuns
+    };
+
     // The extrapolated positions are the roles' positions at the end of the recorded period
     // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
     // a recurrence path (assigned anew when they change); a second DEM run moves, so each of
@@ -397,14 +406,6 @@ pub fn compare_runs(
     // same run (another period τ, more recorded periods) the reference t_k it lands on; its
     // snapshots between two reference instants are skipped, and each compared one is measured
     // over the stretch since the last compared one (t_{k−1} → t_k).
-    // An extrapolation that follows the reference past t1 (several recorded periods) is
-    // measured against the runs that parted from that shared past at t1: the twins and any
-    // further runs, not the reference (floor::Against).
-    let against = if recorded_until >= 2 {
-        floor::Against::AllButTheReference
-    } else {
-        floor::Against::AllRuns
-    };
     let half_step = 0.5 * recording.info().dt;
     let dem_index_at = |time: f64| {
         dem.iter()
