@@ -46,26 +46,36 @@ pub(crate) fn num(x: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// The decimals (2 to 6) that put `x`, rounded, on the same side of 1 as `x` itself.
+fn decimals_beside_one(x: f64) -> usize {
+    let side = x.partial_cmp(&1.0);
+    let mut decimals = 2;
+    while decimals < 6
+        && format!("{x:.decimals$}")
+            .parse::<f64>()
+            .unwrap_or(x)
+            .partial_cmp(&1.0)
+            != side
+    {
+        decimals += 1;
+    }
+    decimals
+}
+
 /// A median ratio with the decimals that put it on its side of 1 (`0.997`, not `1`, for
 /// a median that passes; `1.004` for one that does not).
 fn beside_one(x: f64) -> String {
     if x > 1.0 {
         return above_one(x);
     }
-    let mut decimals = 2;
-    while decimals < 6 && x < 1.0 && format!("{x:.decimals$}").parse::<f64>().unwrap_or(x) >= 1.0 {
-        decimals += 1;
-    }
+    let decimals = decimals_beside_one(x);
     let s = format!("{x:.decimals$}");
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
 /// A ratio said to exceed 1, with the decimals that show it does (`1.004`, not `1`).
 fn above_one(x: f64) -> String {
-    let mut decimals = 2;
-    while decimals < 6 && format!("{x:.decimals$}").parse::<f64>().unwrap_or(x) <= 1.0 {
-        decimals += 1;
-    }
+    let decimals = decimals_beside_one(x);
     format!("{x:.decimals$}")
 }
 
