@@ -271,16 +271,18 @@ pub fn compare_runs(
         check_same_instants((recording, &dem), (run, &snaps))?;
         others.push(snaps);
     }
-    // The last snapshot index that is still the recorded run's (0: none, a second DEM run).
-    let mut recorded_until = 0u32;
+    // The last snapshot index that is still the recorded run's (0: none, a second DEM run):
+    // periods 1 … j − 1 before the first jump j end at t2 … t_j.
+    let recorded_until = match &second {
+        Second::Extrapolation(extrapolation) => extrapolation
+            .info()
+            .roles
+            .first_jump()
+            .map_or(u32::MAX, |j| u32::try_from(j).unwrap_or(u32::MAX)),
+        Second::Dem(_) => 0,
+    };
     let (extra_path, extra, kind, own_groups) = match second {
         Second::Extrapolation(extrapolation) => {
-            // periods 1 … j − 1 before the first jump j end at t2 … t_j
-            recorded_until = extrapolation
-                .info()
-                .roles
-                .first_jump()
-                .map_or(u32::MAX, |j| u32::try_from(j).unwrap_or(u32::MAX));
             let extra_path = extrapolation.path().display().to_string();
             let own = &extrapolation.info().recording_info;
             if own != recording.info() && !same_run(own, recording.info()) {
