@@ -301,8 +301,29 @@ fn build(x0: &[[f64; 3]], idx: &mut [u32], offset: usize, nodes: &mut Vec<Node>)
 pub(crate) struct Check {
     /// Violating pairs (row, column), sorted.
     pub(crate) violations: Vec<(u32, u32)>,
+    /// Pairs that are not candidate edges and hold within the memo's slack (`0 <=
+    /// c − u − v < slack`), at most `per_row` per row, the tightest first; sorted. Added
+    /// to the graph with the violations, they cannot become violations when a repair
+    /// solve raises their row's `u` by less than their margin: on the long kiln one exact
+    /// round fewer (docs/benchmarks.md, nineteenth session). Empty with a slack of 0.
+    pub(crate) close: Vec<(u32, u32)>,
     /// How many pairs were tested exactly (work counter).
     pub(crate) examined: u64,
+}
+
+/// One row's part of a pass (the default: a row not examined).
+#[derive(Default)]
+struct RowCheck {
+    /// Violating columns, the most negative `limit`, sorted.
+    violating: Vec<u32>,
+    /// Close columns ([`Check::close`]), sorted.
+    close: Vec<u32>,
+    /// Points tested exactly.
+    examined: u64,
+    /// More violations than `limit`: examine the row again next pass.
+    truncated: bool,
+    /// The row's new bound (`None`: not examined, the old one holds).
+    bound: Option<i64>,
 }
 
 /// What the previous passes proved, so that a pass only re-examines the rows where a
@@ -313,14 +334,15 @@ pub(crate) struct Check {
 /// returned more than its limit of pairs per row: then the row is examined again next
 /// time). Its search reaches `slack` units beyond the violations (`c − v < u[p] +
 /// slack`): every column it does not reach has `c − v >= u[p] + slack`, and the ones
-/// it reaches give their exact `c − v`. Candidate edges and returned pairs stay in the
-/// graph, where the solver keeps them non-violating. Column potentials never increase
+/// it reaches give their exact `c − v`. Candidate edges and returned pairs (violating
+/// or [`Check::close`]) stay in the graph, where the solver keeps them non-violating. Column potentials never increase
 /// in this solver (augmentations and auction bids only lower them; this is checked, and
 /// a full pass is made if it ever fails), so `c − v` only grows and the bound still
 /// holds later: the row needs examining again only once its own `u[p]` exceeds `b[p]`.
 /// With `slack = 0` that is as soon as `u[p]` grew at all since its last examination;
 /// a small slack spares the rows whose `u` a repair solve raises by a little, for a
-/// slightly larger search.
+/// slightly larger search, and the pairs within it join the graph before they can
+/// violate.
 pub(crate) struct Memo {
     /// `b[p]` (`i64::MIN`: never examined).
     bound: Vec<i64>,
@@ -330,13 +352,14 @@ pub(crate) struct Memo {
     again: Vec<bool>,
     /// How far beyond the violations a search reaches, in cost units (>= 0).
     slack: i64,
-    /// At most this many violating pairs per row are returned (at least 1).
+    /// At most this many violating pairs, and as many close ones, per row are returned
+    /// (at least 1).
     per_row: usize,
 }
 
 impl Memo {
     /// Nothing proven yet; searches reach `slack` cost units beyond the violations and
-    /// return at most `per_row` violating pairs per row.
+    /// return at most `per_row` violating pairs and `per_row` close ones per row.
     pub(crate) fn new(slack: i64, per_row: usize) -> Self {
         Self {
             bound: Vec::new(),
@@ -376,25 +399,27 @@ pub(crate) fn check(
     let tree = &*tree;
     let (memo_bound, memo_again, slack, limit) =
         (&memo.bound, &memo.again, memo.slack, memo.per_row);
-    // Per row: the returned columns, the points examined, whether the list was
-    // truncated, and the row's new bound (`None`: not examined, the old one holds).
-    let per_row: Vec<(Vec<u32>, u64, bool, Option<i64>)> = (0..n)
+    let per_row: Vec<RowCheck> = (0..n)
         .into_par_iter()
         .with_min_len(256)
         .map_init(Vec::new, |stack, p| {
             let u = lap.u(p);
             if !memo_again[p] && u <= memo_bound[p] {
-                return (Vec::new(), 0, false, None); // proven at an earlier pass, still holds
+                return RowCheck::default(); // proven at an earlier pass, still holds
             }
             if u + v_max <= 0 {
                 // c >= 0 and v <= v_max: c − v >= −v_max >= u for every column.
-                return (Vec::new(), 0, false, Some(-v_max));
+                return RowCheck {
+                    bound: Some(-v_max),
+                    ..RowCheck::default()
+                };
             }
             // Every column with c − v <= u + slack − 1 has d + W < r (the module
             // documentation's argument, with u + slack for u).
             let r = ((u + slack + v_max) as f64 + 0.5) * unit * (1.0 + REL_MARGIN);
+            // (reduced cost, column)
             let mut bad: Vec<(i64, u32)> = Vec::new();
-            let mut near = slack;
+            let mut close: Vec<(i64, u32)> = Vec::new();
             let mut examined = 0u64;
             let edges = graph.row(p).0;
             tree.search(&x1[p], r, stack, |t| {
@@ -403,30 +428,46 @@ pub(crate) fn check(
                 let reduced = scale.cost(&x1[p], &tree.point(t)) - u - lap.v(q as usize);
                 if reduced < 0 {
                     bad.push((reduced, q));
-                } else if reduced < near && !edges.contains(&q) {
-                    near = reduced;
+                } else if reduced < slack && !edges.contains(&q) {
+                    close.push((reduced, q));
                 }
             });
             let truncated = bad.len() > limit;
-            bad.sort_unstable();
-            bad.truncate(limit);
-            let mut cols: Vec<u32> = bad.into_iter().map(|(_, q)| q).collect();
-            cols.sort_unstable();
-            (cols, examined, truncated, Some(u + near))
+            // The tightest `limit` of each list, as sorted columns.
+            let keep = |mut pairs: Vec<(i64, u32)>| -> Vec<u32> {
+                pairs.sort_unstable();
+                pairs.truncate(limit);
+                let mut cols: Vec<u32> = pairs.into_iter().map(|(_, q)| q).collect();
+                cols.sort_unstable();
+                cols
+            };
+            // The bound holds over the columns neither candidates nor returned: past the
+            // close pairs returned, the first one left out, or the slack.
+            close.sort_unstable();
+            let near = close.get(limit).map_or(slack, |&(reduced, _)| reduced);
+            RowCheck {
+                violating: keep(bad),
+                close: keep(close),
+                examined,
+                truncated,
+                bound: Some(u + near),
+            }
         })
         .collect();
-    let mut violations = Vec::new();
+    let (mut violations, mut close) = (Vec::new(), Vec::new());
     let mut examined = 0;
-    for (p, (bad, m, truncated, bound)) in per_row.into_iter().enumerate() {
-        if let Some(b) = bound {
+    for (p, row) in per_row.into_iter().enumerate() {
+        if let Some(b) = row.bound {
             memo.bound[p] = b;
-            memo.again[p] = truncated;
+            memo.again[p] = row.truncated;
         }
-        examined += m;
-        violations.extend(bad.into_iter().map(|q| (p as u32, q)));
+        examined += row.examined;
+        violations.extend(row.violating.into_iter().map(|q| (p as u32, q)));
+        close.extend(row.close.into_iter().map(|q| (p as u32, q)));
     }
     Check {
         violations,
+        close,
         examined,
     }
 }
@@ -434,6 +475,71 @@ pub(crate) fn check(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A pass's close pairs are non-candidate pairs within the slack, at most `per_row`
+    /// a row, and the bound it keeps holds over every column it neither has as an edge
+    /// nor returned (brute force over all n² pairs), with far more close columns than it
+    /// may return.
+    #[test]
+    fn close_pairs_and_the_bound_past_them() {
+        let mut rnd = super::super::test_uniform(777);
+        let n = 300;
+        let x0: Vec<[f64; 3]> = (0..n).map(|_| [rnd(), rnd(), 3.0 * rnd()]).collect();
+        // Each t1 point next to its own t0 point, so that its nearest candidates hold a
+        // perfect matching and a solve on them succeeds.
+        let x1: Vec<[f64; 3]> = x0
+            .iter()
+            .map(|p| {
+                [
+                    p[0] + 1e-4 * rnd(),
+                    p[1] + 1e-4 * rnd(),
+                    p[2] + 1e-4 * rnd(),
+                ]
+            })
+            .collect();
+        let unit = 1e-6;
+        let scale = CostScale::new(&x0, &x1, unit).unwrap();
+        let grid = super::super::candidates::Grid::new(&x0);
+        let k = 3;
+        let (kc, kw) = super::super::candidates::knn(&grid, &x0, &x1, &x1, k, &scale);
+        let graph = Graph::from_knn(k, kc, kw);
+        let mut lap = Lap::new(n);
+        lap.solve(&graph).unwrap();
+        let mut tree = WeightedTree::new(&x0);
+        // A slack of 0.3 (a few point spacings): dozens of close columns per row.
+        let per_row = 2;
+        let mut memo = Memo::new((0.3 / unit) as i64, per_row);
+        let check = check(&mut tree, &x1, &lap, &graph, &scale, &mut memo);
+        assert!(!check.close.is_empty());
+        let mut returned = vec![Vec::new(); n];
+        for &(p, q) in check.violations.iter().chain(&check.close) {
+            returned[p as usize].push(q);
+        }
+        for &(p, q) in &check.close {
+            let (p, q) = (p as usize, q as usize);
+            let reduced = scale.cost(&x1[p], &x0[q]) - lap.u(p) - lap.v(q);
+            assert!((0..memo.slack).contains(&reduced), "{p} {q}: {reduced}");
+            assert!(!graph.row(p).0.contains(&(q as u32)));
+        }
+        let mut truncated_rows = 0;
+        for p in 0..n {
+            let close = check.close.iter().filter(|e| e.0 as usize == p).count();
+            assert!(close <= per_row);
+            truncated_rows += usize::from(memo.bound[p] < lap.u(p) + memo.slack);
+            if memo.again[p] {
+                continue; // no bound claimed
+            }
+            for (q, at_t0) in x0.iter().enumerate() {
+                if graph.row(p).0.contains(&(q as u32)) || returned[p].contains(&(q as u32)) {
+                    continue;
+                }
+                let margin = scale.cost(&x1[p], at_t0) - lap.v(q);
+                assert!(margin >= memo.bound[p], "row {p}, column {q}");
+            }
+        }
+        // The bound stops at a close column left out on many rows, not at the slack.
+        assert!(truncated_rows > n / 2, "{truncated_rows}");
+    }
 
     /// The weighted search returns exactly the brute-force set {q : d + W_q < r}.
     #[test]

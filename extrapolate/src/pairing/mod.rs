@@ -650,20 +650,25 @@ fn sparse(
         examined += check.examined;
         trace!(
             t,
-            "round {rounds}: certificate {} examined, {}",
+            "round {rounds}: certificate {} examined, {}; {} close pairs",
             check.examined,
-            describe(&check.violations, x0, x1, scale)
+            describe(&check.violations, x0, x1, scale),
+            check.close.len()
         );
         if check.violations.is_empty() {
             break true;
         }
         // Every violation is a new edge (candidate edges cannot violate), so the graph
-        // grows strictly each round and the loop ends, at worst with all n² pairs.
-        added += check.violations.len();
-        // The violations come sorted by row.
+        // grows strictly each round and the loop ends, at worst with all n² pairs. The
+        // close pairs are new edges too; they join the graph before a solve can make
+        // them violate.
+        // Only the rows with a violation can break the invariant (sorted by row).
         let mut touched: Vec<usize> = check.violations.iter().map(|e| e.0 as usize).collect();
         touched.dedup();
-        graph.insert(&check.violations, x0, x1, scale);
+        let mut pairs = check.violations;
+        pairs.extend(check.close);
+        pairs.sort_unstable();
+        added += graph.insert(&pairs, x0, x1, scale);
         let freed = lap.restore_invariant_on(&graph, touched);
         trace!(t, "round {rounds}: {freed} rows freed");
     };
