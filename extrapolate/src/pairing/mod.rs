@@ -658,13 +658,13 @@ fn sparse(
         if check.violations.is_empty() {
             break true;
         }
+        // Only the rows with a violation can break the invariant (sorted by row).
+        let mut touched: Vec<usize> = check.violations.iter().map(|e| e.0 as usize).collect();
+        touched.dedup();
         // Every violation is a new edge (candidate edges cannot violate), so the graph
         // grows strictly each round and the loop ends, at worst with all n² pairs. The
         // close pairs are new edges too; they join the graph before a solve can make
         // them violate.
-        // Only the rows with a violation can break the invariant (sorted by row).
-        let mut touched: Vec<usize> = check.violations.iter().map(|e| e.0 as usize).collect();
-        touched.dedup();
         let mut pairs = check.violations;
         pairs.extend(check.close);
         pairs.sort_unstable();
