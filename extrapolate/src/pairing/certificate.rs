@@ -347,13 +347,13 @@ fn tightest(mut pairs: Vec<(i64, u32)>, limit: usize) -> (Vec<u32>, Option<i64>)
 /// slack`): every column it does not reach has `c − v >= u[p] + slack`, and the ones
 /// it reaches give their exact `c − v`. Candidate edges and returned pairs (violating
 /// or [`Check::close`]) stay in the graph, where the solver keeps them non-violating.
-/// Column potentials never increase in this solver (augmentations and auction bids only lower them; this is checked, and
-/// a full pass is made if it ever fails), so `c − v` only grows and the bound still
-/// holds later: the row needs examining again only once its own `u[p]` exceeds `b[p]`.
-/// With `slack = 0` that is as soon as `u[p]` grew at all since its last examination;
-/// a small slack spares the rows whose `u` a repair solve raises by a little, for a
-/// slightly larger search, and the pairs within it join the graph before they can
-/// violate.
+/// Column potentials never increase in this solver (augmentations and auction bids only
+/// lower them; this is checked, and a full pass is made if it ever fails), so `c − v`
+/// only grows and the bound still holds later: the row needs examining again only once
+/// its own `u[p]` exceeds `b[p]`. With `slack = 0` that is as soon as `u[p]` grew at all
+/// since its last examination; a small slack spares the rows whose `u` a repair solve
+/// raises by a little, for a slightly larger search, and the pairs within it join the
+/// graph before they can violate.
 pub(crate) struct Memo {
     /// `b[p]` (`i64::MIN`: never examined).
     bound: Vec<i64>,
@@ -445,7 +445,7 @@ pub(crate) fn check(
                     close.push((reduced, q));
                 }
             });
-            let (violating, truncated) = tightest(bad, limit);
+            let (violating, violation_left_out) = tightest(bad, limit);
             let (close, left_out) = tightest(close, limit);
             // The bound holds over the columns neither candidates nor returned: the first
             // close one left out, or the slack.
@@ -454,7 +454,7 @@ pub(crate) fn check(
                 violating,
                 close,
                 examined,
-                truncated: truncated.is_some(),
+                truncated: violation_left_out.is_some(),
                 bound: Some(u + near),
             }
         })
