@@ -13,10 +13,18 @@ use super::cost::{dist2, CostScale, EdgeCost};
 /// indices.
 pub(crate) type Tree = ImmutableKdTree<f64, 3>;
 
-/// Mean number of t0 points per occupied grid cell: a k-nearest query with k = 24 or
-/// 32 then reads the 125 cells within two of its own. On the long kiln and the pilot
-/// drum, 1 was as fast as 1.4 and faster than 0.6 or 2 (docs/benchmarks.md).
-const POINTS_PER_CELL: f64 = 1.0;
+/// Mean number of t0 points per occupied grid cell. A k-nearest query first reads the
+/// 27 cells around its own ([`Grid::nearest_in_block`]); at 12 points a cell they hold
+/// the 32 nearest for 99 % of the long kiln's queries. 8 and 12 were as fast, 16
+/// slower; the shell search alone, before, was fastest at 1 (docs/benchmarks.md).
+const POINTS_PER_CELL: f64 = 12.0;
+
+/// The radius within which [`Grid::nearest_in_block`] first keeps points, in radii of
+/// the ball that holds k points at the grid's mean density: on a packed bed 1.25 keeps
+/// about twice k, so the second pass (every point of the block) is rare, while the
+/// selection that follows stays short. 1.0 was slower (more second passes), 1.1 to 1.3
+/// alike (docs/benchmarks.md).
+const BLOCK_RADIUS: f64 = 1.25;
 
 /// The t0 points bucketed in a uniform grid of cubic cells over their bounding box, for
 /// the k-nearest queries of [`knn`]. On a packed bed the points fill the box's cells
@@ -194,6 +202,137 @@ impl Grid {
     }
 }
 
+/// The 27 cells around one grid cell, as the nine runs of cells (each run three cells
+/// along x, contiguous in the grid's arrays) that hold their points, kept from query
+/// to query: consecutive rows are near in Morton order and share a cell about half
+/// the time on the long kiln.
+struct Block {
+    /// The grid cell the runs surround (`usize::MAX`: none yet).
+    cell: usize,
+    /// Every t0 point inside the box `[lo, hi]` is in the runs (an infinite side: no
+    /// point lies beyond the runs on that side).
+    lo: [f64; 3],
+    hi: [f64; 3],
+    /// Point ranges `start..end` in the grid's `pts` and `idx`.
+    runs: Vec<(u32, u32)>,
+    /// Scratch for the points within the kept radius.
+    near: Vec<(f64, u32)>,
+}
+
+impl Block {
+    fn new() -> Self {
+        Self {
+            cell: usize::MAX,
+            lo: [0.0; 3],
+            hi: [0.0; 3],
+            runs: Vec::with_capacity(9),
+            near: Vec::new(),
+        }
+    }
+}
+
+impl Grid {
+    /// Square of [`BLOCK_RADIUS`] times the radius of a ball holding k points at the
+    /// grid's mean density (POINTS_PER_CELL per cell).
+    fn block_radius2(&self, k: usize) -> f64 {
+        let volume = k as f64 * self.cell.powi(3) / POINTS_PER_CELL;
+        (BLOCK_RADIUS * (3.0 * volume / (4.0 * std::f64::consts::PI)).cbrt()).powi(2)
+    }
+
+    /// The k nearest points to `q` as [`Grid::nearest`] finds them, from the 27 cells
+    /// around q's cell alone, when those provably hold them; false (and `best`
+    /// unspecified) when they may not.
+    ///
+    /// Every point nearer to q than the block's outside (`reach`) is in the block. A
+    /// first pass keeps the block's points within `radius2.sqrt()` (or `reach`, if
+    /// nearer): if there are k or more, the k nearest of them are the k nearest of all.
+    /// Otherwise a second pass keeps every point within `reach`, and fewer than k then
+    /// means the answer may lie outside. The passes read the runs straight through and
+    /// keep a point by advancing a count, not by a branch: where the cut falls is
+    /// unpredictable, and the shell search's branches and per-cell loops were most of
+    /// its time (docs/benchmarks.md).
+    fn nearest_in_block(
+        &self,
+        q: &[f64; 3],
+        k: usize,
+        radius2: f64,
+        block: &mut Block,
+        best: &mut Vec<(f64, u32)>,
+    ) -> bool {
+        if !q.iter().all(|x| x.is_finite()) {
+            return false; // the shell search decides
+        }
+        let c = self.coords(q);
+        let cell = c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2]);
+        if cell != block.cell {
+            block.cell = cell;
+            block.runs.clear();
+            // Cells exist beyond the block's below c − 1 only if c ≥ 2, above c + 1 only
+            // if c + 2 is a cell.
+            block.lo = std::array::from_fn(|a| {
+                if c[a] >= 2 {
+                    self.lo[a] + (c[a] - 1) as f64 * self.cell
+                } else {
+                    f64::NEG_INFINITY
+                }
+            });
+            block.hi = std::array::from_fn(|a| {
+                if c[a] + 2 < self.dims[a] {
+                    self.lo[a] + (c[a] + 2) as f64 * self.cell
+                } else {
+                    f64::INFINITY
+                }
+            });
+            let (x_lo, x_hi) = (c[0].saturating_sub(1), (c[0] + 1).min(self.dims[0] - 1));
+            for z in c[2].saturating_sub(1)..=(c[2] + 1).min(self.dims[2] - 1) {
+                for y in c[1].saturating_sub(1)..=(c[1] + 1).min(self.dims[1] - 1) {
+                    let row = self.dims[0] * (y + self.dims[1] * z);
+                    let run = (self.start[row + x_lo], self.start[row + x_hi + 1]);
+                    if run.0 < run.1 {
+                        block.runs.push(run);
+                    }
+                }
+            }
+        }
+        let reach = (0..3)
+            .map(|a| (q[a] - block.lo[a]).min(block.hi[a] - q[a]))
+            .fold(f64::INFINITY, f64::min);
+        // The same margin as the shell search's.
+        let reach = reach - 1e-9 * self.cell;
+        if reach <= 0.0 {
+            return false; // not reached: rounding at a cell's face
+        }
+        let reach2 = reach * reach;
+        let held: usize = block.runs.iter().map(|&(a, b)| (b - a) as usize).sum();
+        if block.near.len() <= held {
+            block.near.resize(held + 1, (0.0, 0));
+        }
+        let mut within2 = radius2.min(reach2);
+        let kept = loop {
+            let mut kept = 0usize;
+            for &(a, b) in &block.runs {
+                let (a, b) = (a as usize, b as usize);
+                for (p, &i) in self.pts[a..b].iter().zip(&self.idx[a..b]) {
+                    let d = dist2(q, p);
+                    block.near[kept] = (d, i);
+                    kept += usize::from(d < within2);
+                }
+            }
+            if kept >= k {
+                break kept;
+            }
+            if within2 >= reach2 {
+                return false;
+            }
+            within2 = reach2;
+        };
+        best.clear();
+        best.extend_from_slice(&block.near[..kept]);
+        keep_nearest(best, k);
+        true
+    }
+}
+
 /// The order of the nearest: squared distance, ties to the lower index.
 #[inline]
 fn order(a: &(f64, u32), b: &(f64, u32)) -> std::cmp::Ordering {
@@ -230,16 +369,26 @@ pub(crate) fn knn(
     let k = k.clamp(1, x0.len());
     let mut cols = vec![0u32; n * k];
     let mut costs: Vec<EdgeCost> = vec![0; n * k];
+    let radius2 = grid.block_radius2(k);
     // Each row writes only its own k-slot chunk: embarrassingly parallel and
-    // deterministic (no collection order to worry about).
+    // deterministic (no collection order to worry about; both searches give the same
+    // k nearest).
     cols.par_chunks_mut(k)
         .zip(costs.par_chunks_mut(k))
         .enumerate()
         .with_min_len(256)
         .for_each_init(
-            || (Vec::with_capacity(2 * k), Vec::with_capacity(k)),
-            |(found, row), (p, (cc, cs))| {
-                grid.nearest(&centres[p], k, found);
+            || {
+                (
+                    Vec::with_capacity(2 * k),
+                    Vec::with_capacity(k),
+                    Block::new(),
+                )
+            },
+            |(found, row, block), (p, (cc, cs))| {
+                if !grid.nearest_in_block(&centres[p], k, radius2, block, found) {
+                    grid.nearest(&centres[p], k, found);
+                }
                 row.clear();
                 row.extend(
                     found
@@ -617,7 +766,9 @@ mod tests {
 
     /// The grid's k nearest are the brute force's (by squared distance, ties to the
     /// lower index) for queries inside and outside the points' box, on a bulk bed, a
-    /// flat one, a line and a lattice with exact ties.
+    /// flat one, a line and a lattice with exact ties: the shell search always, the
+    /// block search whenever it answers (with its first radius, and with none, which
+    /// forces its second pass), and it answers for most queries of the bulk bed.
     #[test]
     fn grid_nearest_matches_brute_force() {
         let mut rnd = super::super::test_uniform(77);
@@ -628,9 +779,11 @@ mod tests {
             .map(|i| [(i % 7) as f64, ((i / 7) % 7) as f64, (i / 49) as f64])
             .collect();
         let one = vec![[1.0, 2.0, 3.0]; 5];
-        for x0 in [bulk, flat, line, lattice, one] {
+        for (bed, x0) in [bulk, flat, line, lattice, one].into_iter().enumerate() {
             let grid = Grid::new(&x0);
             let mut best = Vec::new();
+            let mut block = Block::new();
+            let (mut asked, mut answered) = (0, 0);
             for t in 0..60 {
                 let q = if t % 3 == 0 {
                     x0[t % x0.len()]
@@ -649,7 +802,24 @@ mod tests {
                     all.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
                     all.truncate(k);
                     assert_eq!(best, all, "k {k}, query {q:?}");
+                    // Queries at the bed's own points, with k below the whole bed: the
+                    // case the block is for.
+                    let typical = t % 3 == 0 && k <= 24;
+                    for radius2 in [grid.block_radius2(k), 0.0] {
+                        asked += usize::from(typical);
+                        if grid.nearest_in_block(&q, k, radius2, &mut block, &mut best) {
+                            answered += usize::from(typical);
+                            best.sort_by(order);
+                            assert_eq!(best, all, "block, k {k}, r² {radius2}, query {q:?}");
+                        }
+                    }
                 }
+            }
+            if bed == 0 {
+                assert!(
+                    2 * answered > asked,
+                    "the block answered {answered} of {asked} queries at the bed's points"
+                );
             }
         }
     }
