@@ -143,7 +143,10 @@ pub enum PairingError {
     #[error("the snapshots are empty: nothing to pair")]
     Empty,
     /// A coordinate is NaN or infinite.
-    #[error("non-finite coordinate in the {snapshot} snapshot: particle {index}, axis {axis} is {value}")]
+    #[error(
+        "non-finite coordinate in the {snapshot} snapshot: particle {index}, axis {axis} \
+         is {value}"
+    )]
     NonFinite {
         snapshot: &'static str,
         index: usize,
@@ -371,7 +374,8 @@ fn describe(
         / pairs.len() as f64
         / (scale.unit() * 1e6);
     format!(
-        "{} pairs on {} rows, cost mean {mean:.2} max {max:.2} (1e6 units), mean |dy| {dy:.2}, row y q0/10/50/90/100 {:.3} {:.3} {:.3} {:.3} {:.3}",
+        "{} pairs on {} rows, cost mean {mean:.2} max {max:.2} (1e6 units), mean |dy| \
+         {dy:.2}, row y q0/10/50/90/100 {:.3} {:.3} {:.3} {:.3} {:.3}",
         pairs.len(),
         rows.len(),
         qy(0.0),
@@ -445,7 +449,8 @@ fn sparse(
     let rho = cheapest.mean() * scale.unit();
     trace!(
         t,
-        "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, sampled {rho_sampled:.3e}) + knn k {k0} + graph"
+        "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, sampled \
+         {rho_sampled:.3e}) + knn k {k0} + graph"
     );
     let v_axial = axial.potentials(x0, rho, scale.unit());
     let mut eps0 = cheapest.initial_eps();
