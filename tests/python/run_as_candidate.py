@@ -68,14 +68,15 @@ def eps_abs(a, b):
     return np.abs(a[both] - b[both]).mean()
 
 
-def main(path, cells=200, seed=1):
+def ratios(path, cells=200, seed=1):
+    """({(run, k): ratio of run c to the others' floor}, the runs, the t_k all runs hold)."""
     runs = runs_at(path)
     assert len(runs) >= 3, f"{path}: {len(runs)} DEM runs; a candidate needs at least two others"
     ref = runs[0]
     bed1 = np.stack([ref[1]["x"], ref[1]["y"], ref[1]["z"]], 1)
     seeds = cells_inside_bed(bed1, ref[1]["r"].max(), cells, seed)
     ks = sorted(k for k in ref if k >= 2 and all(k in r for r in runs.values()))
-    ratio = {}  # (run, k) -> ratio to the others' floor
+    ratio = {}
     for k in ks:
         means = {m: cell_means(seeds, runs[m][k]) for m in runs}
         dist = {(a, b): eps_abs(means[a], means[b]) for a in runs for b in runs if a < b}
@@ -85,17 +86,27 @@ def main(path, cells=200, seed=1):
             to_others = np.mean([d(c, m) for m in others])
             floor = np.mean([d(a, b) for i, a in enumerate(others) for b in others[i + 1:]])
             ratio[(c, k)] = to_others / floor
-    medians = []
-    print(f"{path}: {len(runs)} DEM runs, {cells} cells (numpy seed {seed}), t_k = {ks[0]}…{ks[-1]}")
+    return ratio, sorted(runs), ks
+
+
+def window_medians(ratio, runs, ks):
+    """[(start s, [each run's median ratio over t_{s+1} … t_{s+WINDOW}])] for every full window."""
+    out = []
     for s in range(1, ks[-1] - WINDOW + 1):
         window = [k for k in range(s + 1, s + WINDOW + 1) if k in ks]
-        if len(window) < WINDOW:
-            continue
-        row = [statistics.median(ratio[(c, k)] for k in window) for c in sorted(runs)]
-        medians += [(s, m) for m in row]
-        print(f"start t{s} (t{window[0]}…t{window[-1]}): median ratio per run "
+        if len(window) == WINDOW:
+            out.append((s, [statistics.median(ratio[(c, k)] for k in window) for c in runs]))
+    return out
+
+
+def main(path, cells=200, seed=1):
+    ratio, runs, ks = ratios(path, cells, seed)
+    print(f"{path}: {len(runs)} DEM runs, {cells} cells (numpy seed {seed}), t_k = {ks[0]}…{ks[-1]}")
+    values = []
+    for s, row in window_medians(ratio, runs, ks):
+        values += row
+        print(f"start t{s} (t{s + 1}…t{s + WINDOW}): median ratio per run "
               + ", ".join(f"{m:.2f}" for m in row))
-    values = [m for _, m in medians]
     print(f"all windows: {len(values)} medians, mean {statistics.mean(values):.3f}, "
           f"standard deviation {statistics.stdev(values):.3f}, {min(values):.2f}–{max(values):.2f}, "
           f"{sum(v <= 1 for v in values)} at most 1")
