@@ -47,7 +47,7 @@ def main(folder, beds):
                for b in beds for k in range(1 if m == "c" else 2, 9)} for m in "cde"}
     dem = {}
     for b in beds:
-        ratio, runs, ks = run_as_candidate.ratios(f"{folder}/s{b}.mcap")
+        ratio, runs, ks, _ = run_as_candidate.ratios(f"{folder}/s{b}.mcap")
         for s, row in run_as_candidate.window_medians(ratio, runs, ks):
             dem[(b, s)] = row
     for lo, hi in [(1, 4), (2, 4), (2, 5)]:

@@ -69,7 +69,8 @@ def eps_abs(a, b):
 
 
 def ratios(path, cells=200, seed=1):
-    """({(run, k): ratio of run c to the others' floor}, the runs, the t_k all runs hold)."""
+    """({(run, k): ratio of run c to the others' floor}, the runs, the t_k all runs hold,
+    {k: mean eps_abs over all pairs of runs})."""
     runs = runs_at(path)
     assert len(runs) >= 3, f"{path}: {len(runs)} DEM runs; a candidate needs at least two others"
     ref = runs[0]
@@ -77,16 +78,18 @@ def ratios(path, cells=200, seed=1):
     seeds = cells_inside_bed(bed1, ref[1]["r"].max(), cells, seed)
     ks = sorted(k for k in ref if k >= 2 and all(k in r for r in runs.values()))
     ratio = {}
+    floors = {}
     for k in ks:
         means = {m: cell_means(seeds, runs[m][k]) for m in runs}
         dist = {(a, b): eps_abs(means[a], means[b]) for a in runs for b in runs if a < b}
         d = lambda a, b: dist[(min(a, b), max(a, b))]
+        floors[k] = np.mean(list(dist.values()))
         for c in runs:
             others = [m for m in runs if m != c]
             to_others = np.mean([d(c, m) for m in others])
             floor = np.mean([d(a, b) for i, a in enumerate(others) for b in others[i + 1:]])
             ratio[(c, k)] = to_others / floor
-    return ratio, sorted(runs), ks
+    return ratio, sorted(runs), ks, floors
 
 
 def window_medians(ratio, runs, ks):
@@ -100,8 +103,10 @@ def window_medians(ratio, runs, ks):
 
 
 def main(path, cells=200, seed=1):
-    ratio, runs, ks = ratios(path, cells, seed)
+    ratio, runs, ks, floors = ratios(path, cells, seed)
     print(f"{path}: {len(runs)} DEM runs, {cells} cells (numpy seed {seed}), t_k = {ks[0]}…{ks[-1]}")
+    print("floor (mean eps_abs over all pairs of runs, K, to set beside tdex compare's floor_eps_abs): "
+          + ", ".join(f"t{k} {floors[k]:.3f}" for k in ks))
     values = []
     for s, row in window_medians(ratio, runs, ks):
         values += row
