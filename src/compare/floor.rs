@@ -20,6 +20,12 @@ pub struct Floor {
     /// `eps_abs_to_dem_runs / floor_eps_abs`; absent when the DEM runs are identical
     /// (floor 0): nothing to judge against, not an infinite ratio.
     pub ratio_to_floor: Option<f64>,
+    /// Each DEM run (in the order given) judged as the second field is: its mean `ε_abs` to
+    /// the other runs over their mean distance to each other; `None` where those others are
+    /// identical. Empty with fewer than three runs (two others are needed for a floor). The
+    /// yardstick's own scatter: what a genuine run scores in the second field's seat, with
+    /// one run fewer to be judged against.
+    pub runs_ratio_to_others: Vec<Option<f64>>,
 }
 
 /// Whether an extrapolation is within the DEM runs' own range at one `t_k`: its mean distance
@@ -62,10 +68,16 @@ pub fn floor(
         return None;
     }
     let means: Vec<Vec<Option<f64>>> = runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
+    // distance[i][j] between runs i and j (both halves filled)
+    let n = means.len();
+    let mut distance = vec![vec![0.0; n]; n];
     let mut pairs = Vec::new();
-    for (i, a) in means.iter().enumerate() {
-        for b in &means[i + 1..] {
-            pairs.push(eps_abs(a, b)?.0);
+    for i in 0..n {
+        for j in i + 1..n {
+            let d = eps_abs(&means[i], &means[j])?.0;
+            distance[i][j] = d;
+            distance[j][i] = d;
+            pairs.push(d);
         }
     }
     let skip = match against {
@@ -79,6 +91,23 @@ pub fn floor(
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let floor_eps_abs = mean(&pairs);
     let eps_abs_to_dem_runs = mean(&to_runs);
+    let runs_ratio_to_others = if n < 3 {
+        Vec::new()
+    } else {
+        (0..n)
+            .map(|c| {
+                let to_others: Vec<f64> =
+                    (0..n).filter(|&j| j != c).map(|j| distance[c][j]).collect();
+                let among: Vec<f64> = (0..n)
+                    .flat_map(|a| (a + 1..n).map(move |b| (a, b)))
+                    .filter(|&(a, b)| a != c && b != c)
+                    .map(|(a, b)| distance[a][b])
+                    .collect();
+                let floor = mean(&among);
+                (floor > 0.0).then(|| mean(&to_others) / floor)
+            })
+            .collect()
+    };
     Some(Floor {
         floor_eps_abs,
         floor_eps_abs_min: pairs.iter().copied().fold(f64::INFINITY, f64::min),
@@ -86,6 +115,7 @@ pub fn floor(
         floor_pairs: pairs.len(),
         eps_abs_to_dem_runs,
         ratio_to_floor: (floor_eps_abs > 0.0).then(|| eps_abs_to_dem_runs / floor_eps_abs),
+        runs_ratio_to_others,
     })
 }
 
@@ -182,6 +212,38 @@ mod tests {
         assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
         assert_eq!(twins.ratio_to_floor, Some(1.0));
         assert_eq!(twins.floor_eps_abs, all.floor_eps_abs);
+    }
+
+    /// Each run judged against the others as the second field is: a run far from two that
+    /// agree scores high, and they score low, since their pool holds it.
+    #[test]
+    fn each_run_is_judged_against_the_others_as_the_second_field_is() {
+        let temps = [
+            [10.0, 20.0, 30.0, 40.0], // cell means (15, 35)
+            [12.0, 22.0, 30.0, 40.0], // (17, 35): 1 K from the first on average
+            [20.0, 30.0, 30.0, 40.0], // (25, 35): 5 and 4 K from the others
+        ];
+        let runs: Vec<Field> = temps.iter().map(|t| Field { pos: &POS, temp: t }).collect();
+        let on_first = [Some(15.0), Some(35.0)];
+        let f = floor(&cells(), &runs, &on_first, Against::AllRuns).unwrap();
+        // run 0: to the others (1 + 5) / 2 = 3, their distance 4; run 1: (1 + 4) / 2 over 5;
+        // run 2: (5 + 4) / 2 over 1
+        assert_eq!(
+            f.runs_ratio_to_others,
+            vec![Some(3.0 / 4.0), Some(2.5 / 5.0), Some(4.5)]
+        );
+        // the floor and the second field's ratio are those of all three runs
+        assert_eq!(f.floor_eps_abs, 10.0 / 3.0);
+        assert_eq!(f.eps_abs_to_dem_runs, 2.0);
+        // two runs: neither has a floor of others to be judged against
+        let two = floor(&cells(), &runs[..2], &on_first, Against::AllRuns).unwrap();
+        assert!(two.runs_ratio_to_others.is_empty());
+        // identical others give no ratio, not an infinite one
+        let same = [temps[0], temps[0], temps[1]];
+        let runs: Vec<Field> = same.iter().map(|t| Field { pos: &POS, temp: t }).collect();
+        let f = floor(&cells(), &runs, &on_first, Against::AllRuns).unwrap();
+        assert_eq!(f.runs_ratio_to_others[2], None);
+        assert_eq!(f.runs_ratio_to_others[0], Some(0.5));
     }
 
     #[test]

@@ -105,6 +105,10 @@ pub struct PeriodComparison {
     pub floor_eps_rel: Option<f64>,
     pub eps_abs_to_dem_runs: Option<f64>,
     pub ratio_to_floor: Option<f64>,
+    /// Each DEM run (the reference, then the further runs) judged as the second field is,
+    /// against the others: its mean `ε_abs` to them over their mean distance to each other
+    /// (empty with fewer than three runs; null where the others are identical).
+    pub dem_runs_ratio_to_others: Vec<Option<f64>>,
     /// Eq. 10 of each further DEM run against the reference, the largest in magnitude.
     pub floor_energy_error: Option<f64>,
     /// Group and bed means of the further DEM runs at this `t_k` (twins first).
@@ -517,6 +521,9 @@ pub fn compare_runs(
             floor_eps_rel: floor.as_ref().zip(scale).map(|(f, s)| f.floor_eps_abs / s),
             eps_abs_to_dem_runs: floor.as_ref().map(|f| f.eps_abs_to_dem_runs),
             ratio_to_floor: floor.as_ref().and_then(|f| f.ratio_to_floor),
+            dem_runs_ratio_to_others: floor
+                .as_ref()
+                .map_or_else(Vec::new, |f| f.runs_ratio_to_others.clone()),
             floor_energy_error,
             dem_runs_hot_mean: at_k
                 .iter()

@@ -29,6 +29,10 @@ pub struct Verdict {
     pub means_error_max: Option<f64>,
     /// Largest difference between two DEM runs' group (bed) means, K; null with one run.
     pub means_spread_max: Option<f64>,
+    /// Each DEM run's median ratio over the same `t_k`, judged against the other runs as the
+    /// second field is against all of them (the reference first; empty with fewer than three
+    /// runs): where a genuine run lands on this bar.
+    pub dem_runs_median_ratio: Vec<f64>,
     /// The verdict in words.
     pub text: String,
 }
@@ -171,6 +175,23 @@ impl Verdict {
             }
         }
         let median_ratio = median(&ratios);
+        let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs);
+        // the yardstick beside the median: how the DEM runs themselves score on it
+        let yardstick = match (median_ratio, dem_runs_median_ratio.as_slice()) {
+            (Some(m), runs) if !runs.is_empty() => {
+                let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                let above = runs.iter().filter(|&&r| r > m).count();
+                format!(
+                    "; each DEM run judged the same way against the others: medians {}–{}, {above} of the \
+                     {} above the extrapolation's",
+                    num(lo),
+                    num(hi),
+                    runs.len()
+                )
+            }
+            _ => String::new(),
+        };
         let one_pair = dem_runs == 2;
         let passes = median_ratio.map(|m| m <= 1.0 && (one_pair || outside_range.is_empty()));
         let what = if groups { "group means" } else { "bed mean" };
@@ -204,7 +225,7 @@ impl Verdict {
         let text = match (passes, median_ratio) {
             (Some(true), Some(m)) => format!(
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{left_out}{means}",
+                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}",
                 instants(&compared, compared.len()),
                 beside_one(m),
                 if outside_range.is_empty() {
@@ -247,7 +268,7 @@ impl Verdict {
                 };
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{left_out}{means}",
+                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}",
                     instants(&compared, compared.len()),
                     if m > 1.0 {
                         format!("{} > 1", above_one(m))
@@ -282,9 +303,33 @@ impl Verdict {
             outside_range,
             means_error_max: error,
             means_spread_max: spread,
+            dem_runs_median_ratio,
             text,
         }
     }
+}
+
+/// Each DEM run's median of [`PeriodComparison::dem_runs_ratio_to_others`] over the
+/// `compared` `t_k` (empty unless all `dem_runs` ≥ 3 runs were judged at every one of them,
+/// so that each median is over the same instants as the second field's).
+fn runs_medians(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize) -> Vec<f64> {
+    if dem_runs < 3 || compared.is_empty() {
+        return Vec::new();
+    }
+    let at: Vec<&Vec<Option<f64>>> = periods
+        .iter()
+        .filter(|p| compared.contains(&p.k))
+        .map(|p| &p.dem_runs_ratio_to_others)
+        .collect();
+    (0..dem_runs)
+        .map(|run| {
+            at.iter()
+                .map(|ratios| ratios.get(run).copied().flatten())
+                .collect::<Option<Vec<f64>>>()
+                .and_then(|r| median(&r))
+        })
+        .collect::<Option<Vec<f64>>>()
+        .unwrap_or_default()
 }
 
 #[cfg(test)]
@@ -315,6 +360,7 @@ mod tests {
             floor_eps_rel: Some(floor / 10.0),
             eps_abs_to_dem_runs: Some(ratio * floor),
             ratio_to_floor: Some(ratio),
+            dem_runs_ratio_to_others: Vec::new(),
             floor_energy_error: None,
             dem_runs_hot_mean: vec![310.04],
             dem_runs_cold_mean: vec![300.01],
@@ -401,6 +447,38 @@ mod tests {
         let v = verdict(&[0.96, 1.10, 0.78, 0.88, 0.96, 0.95], 1.05, 5);
         assert_eq!(v.passes, Some(false), "{}", v.text);
         assert!(!v.text.contains("read the median"), "{}", v.text);
+    }
+
+    /// With three or more runs each run is judged against the others over the same t_k,
+    /// and the verdict says where the extrapolation's median falls among theirs.
+    #[test]
+    fn the_dem_runs_own_medians_stand_beside_the_extrapolations() {
+        let mut periods: Vec<PeriodComparison> = [0.96, 1.04, 0.78, 0.88, 0.96, 0.95]
+            .iter()
+            .zip(2..)
+            .map(|(&r, k)| period(k, r, 1.5))
+            .collect();
+        for (p, straggler) in periods.iter_mut().zip([1.2, 1.4, 1.3, 1.3, 1.5, 1.1]) {
+            p.dem_runs_ratio_to_others = vec![Some(0.8), Some(0.9), Some(1.0), Some(straggler)];
+        }
+        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        assert_eq!(v.dem_runs_median_ratio, vec![0.8, 0.9, 1.0, 1.3]);
+        assert!(
+            v.text
+                .contains("each DEM run judged the same way against the others: medians 0.8–1.3, 2 of the 4 above the extrapolation's"),
+            "{}",
+            v.text
+        );
+        // the recorded stretch is left out of the runs' medians as of the extrapolation's
+        periods[0].within_recording = true;
+        periods[0].dem_runs_ratio_to_others[3] = Some(9.0);
+        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        assert_eq!(v.dem_runs_median_ratio[3], 1.3);
+        // a run missing at one compared t_k: no medians, and nothing said
+        periods[2].dem_runs_ratio_to_others.pop();
+        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        assert!(v.dem_runs_median_ratio.is_empty());
+        assert!(!v.text.contains("each DEM run"), "{}", v.text);
     }
 
     #[test]
