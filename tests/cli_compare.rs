@@ -419,6 +419,11 @@ fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
         .map(|k| k.as_u64().unwrap())
         .collect();
     assert_eq!(outside, above);
+    // two runs: no run can be judged against "the others", and the keys are left out
+    assert!(periods
+        .iter()
+        .all(|p| p.get("dem_runs_ratio_to_others").is_none()));
+    assert!(verdict.get("dem_runs_median_ratio").is_none());
     let text = tdex_ok(&["compare", run_s, extra_s, "--cells", "20"]);
     assert!(
         text.lines()
@@ -451,6 +456,109 @@ fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("the recording comes first"), "{err}");
+}
+
+/// Three DEM runs: each is judged against the other two as the extrapolation is against all
+/// three. With three runs the floor's mean, smallest and largest distance give all three
+/// pair distances, so the runs' ratios are known from them whatever the order of the runs:
+/// the run opposite pair (b, c) scores (d_ab + d_ac) / 2 / d_bc.
+#[test]
+fn with_three_dem_runs_each_run_is_judged_against_the_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("case.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    let (run, extra) = (dir.path().join("run.mcap"), dir.path().join("extra.mcap"));
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        run_s,
+        "--tau-rev",
+        "0.25",
+        "--reference",
+        "3",
+        "--twins",
+        "2",
+    ]);
+    tdex_ok(&["extrapolate", run_s, "--periods", "3", "-o", extra_s]);
+    let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["dem_runs"], 3);
+    let verdict = &v["verdict"];
+    let compared: Vec<u64> = verdict["compared"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k.as_u64().unwrap())
+        .collect();
+    assert!(!compared.is_empty(), "{verdict}");
+    let mut per_run: Vec<Vec<f64>> = vec![Vec::new(); 3];
+    for p in v["periods"].as_array().unwrap() {
+        let num = |key: &str| p[key].as_f64().unwrap();
+        let (mean, lo, hi) = (
+            num("floor_eps_abs"),
+            num("floor_eps_abs_min"),
+            num("floor_eps_abs_max"),
+        );
+        let mid = 3.0 * mean - lo - hi;
+        let sum = lo + mid + hi;
+        let mut expected: Vec<f64> = [lo, mid, hi]
+            .iter()
+            .map(|opposite| (sum - opposite) / 2.0 / opposite)
+            .collect();
+        let mut got: Vec<f64> = p["dem_runs_ratio_to_others"]
+            .as_array()
+            .unwrap_or_else(|| panic!("three runs give each run's ratio at k = {}: {p}", p["k"]))
+            .iter()
+            .map(|r| r.as_f64().unwrap())
+            .collect();
+        assert_eq!(got.len(), 3, "{p}");
+        if compared.contains(&p["k"].as_u64().unwrap()) {
+            for (run, ratio) in got.iter().enumerate() {
+                per_run[run].push(*ratio);
+            }
+        }
+        expected.sort_by(f64::total_cmp);
+        got.sort_by(f64::total_cmp);
+        for (e, g) in expected.iter().zip(&got) {
+            assert!(
+                (e - g).abs() <= 1e-9 * e,
+                "expected {expected:?}, got {got:?} at {p}"
+            );
+        }
+    }
+    let medians: Vec<f64> = verdict["dem_runs_median_ratio"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_f64().unwrap())
+        .collect();
+    assert_eq!(medians.len(), 3);
+    for (run, ratios) in per_run.iter_mut().enumerate() {
+        ratios.sort_by(f64::total_cmp);
+        let n = ratios.len();
+        let median = if n % 2 == 1 {
+            ratios[n / 2]
+        } else {
+            0.5 * (ratios[n / 2 - 1] + ratios[n / 2])
+        };
+        assert!(
+            (medians[run] - median).abs() <= 1e-12 * median,
+            "run {run}: {medians:?}"
+        );
+    }
+    let above = medians
+        .iter()
+        .filter(|&&m| m > verdict["median_ratio"].as_f64().unwrap())
+        .count();
+    let text = verdict["text"].as_str().unwrap();
+    assert!(
+        text.contains("each DEM run judged the same way against the others: medians")
+            && text.contains(&format!("{above} of the 3 above the extrapolation's")),
+        "{text}"
+    );
 }
 
 /// `tdex pair --json` states the cycle structure of `g`, which the test counts again from the

@@ -107,7 +107,9 @@ pub struct PeriodComparison {
     pub ratio_to_floor: Option<f64>,
     /// Each DEM run (the reference, then the further runs) judged as the second field is,
     /// against the others: its mean `ε_abs` to them over their mean distance to each other
-    /// (empty with fewer than three runs; null where the others are identical).
+    /// (empty with fewer than three runs, and then left out of the JSON; null where the
+    /// others are identical).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_ratio_to_others: Vec<Option<f64>>,
     /// Eq. 10 of each further DEM run against the reference, the largest in magnitude.
     pub floor_energy_error: Option<f64>,

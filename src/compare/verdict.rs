@@ -31,7 +31,9 @@ pub struct Verdict {
     pub means_spread_max: Option<f64>,
     /// Each DEM run's median ratio over the same `t_k`, judged against the other runs as the
     /// second field is against all of them (the reference first; empty with fewer than three
-    /// runs): where a genuine run lands on this bar.
+    /// runs, and then left out of the JSON so one- and two-run outputs keep their bytes):
+    /// where a genuine run lands on this bar.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_median_ratio: Vec<f64>,
     /// The verdict in words.
     pub text: String,
