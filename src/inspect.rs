@@ -47,8 +47,11 @@ pub struct Sampling {
     pub period_steps: u64,
     pub t0: f64,
     pub reference_periods: u32,
-    /// DEM twins continued from `t1` over the reference periods.
+    /// DEM twins continued from `t_twins_from` over the reference periods.
     pub twins: u32,
+    /// The recorded snapshot the twins part from the run at (absent when 1, as in the file).
+    #[serde(skip_serializing_if = "is_one")]
+    pub twins_from: u32,
     /// Consecutive periods recorded from `t0` (absent when 1, as in the file).
     #[serde(skip_serializing_if = "is_one")]
     pub recorded_periods: u32,
@@ -70,6 +73,7 @@ impl Sampling {
             t0: info.t0,
             reference_periods: info.reference_periods,
             twins: info.twins,
+            twins_from: info.twins_from,
             recorded_periods: info.recorded_periods,
         }
     }
@@ -380,8 +384,8 @@ fn print_human(s: &Inspection) {
             s.sampling.reference_periods,
             match s.sampling.twins {
                 0 => String::new(),
-                1 => ", 1 DEM twin from t1".to_string(),
-                m => format!(", {m} DEM twins from t1"),
+                1 => format!(", 1 DEM twin from t{}", s.sampling.twins_from),
+                m => format!(", {m} DEM twins from t{}", s.sampling.twins_from),
             }
         ),
     );

@@ -154,10 +154,20 @@ fn print_human(report: &RecordReport) {
     let twins = report.sampling.twins;
     if twins > 0 {
         println!(
-            "twins         {twins} DEM run{} continued from t1 over the {} reference periods, \
-             the drum's angular velocity changed by 1{} unit{} in the last place",
+            "twins         {twins} DEM run{} continued from t{} {}, the drum's angular velocity \
+             changed by 1{} unit{} in the last place",
             if twins == 1 { "" } else { "s" },
-            report.sampling.reference_periods,
+            report.sampling.twins_from,
+            match report.sampling.twins_from {
+                1 => format!(
+                    "over the {} reference periods",
+                    report.sampling.reference_periods
+                ),
+                _ => format!(
+                    "to t{} (the run until then)",
+                    report.sampling.reference_periods + 1
+                ),
+            },
             if twins == 1 {
                 String::new()
             } else {

@@ -373,3 +373,57 @@ fn a_recording_with_twins_killed_in_its_reference_and_twin_stages_resumes_to_the
     );
     assert_eq!(file_names(dir.path()), ["a.mcap", "b.mcap", "case.toml"]);
 }
+
+/// Twins that part at t2 (`--twins-from 2`, two recorded periods): killed in the recorded
+/// period before the state at t2 is kept, in the run's reference period and in each twin's,
+/// the run resumes to the same bytes; each twin holds the run's own t2 and parts after it.
+#[test]
+fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let (a, b) = (dir.path().join("a.mcap"), dir.path().join("b.mcap"));
+    let flags = [
+        "--recorded-periods",
+        "2",
+        "--twins",
+        "2",
+        "--twins-from",
+        "2",
+        "--reproducible",
+        "--threads",
+        "2",
+    ];
+    let o = run_tdex(&record_args(&case, &a, &flags));
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+
+    let ck = checkpoint_of(&b);
+    let ck_arg = ck.to_str().unwrap().to_string();
+    let mut args = record_args(&case, &b, &flags);
+    args.extend(["--checkpoint-every", "0.02"]);
+    let mut stops = vec![kill_at(spawn(&args), &ck, ", recorded period 2 of 2")];
+    for stage in [
+        ", reference period 2 of 2",
+        ", twin 1 of 2 reference period 2",
+        ", twin 2 of 2 reference period 2",
+    ] {
+        assert!(!b.exists(), "a killed run left {}", b.display());
+        let resumed = spawn(&["record", "--resume", &ck_arg, "--threads", "1"]);
+        stops.push(kill_at(resumed, &ck, stage));
+    }
+    resume_to_the_end(&ck_arg, &a, &b, &stops);
+    let rec = tdex_format::RecordingReader::open(&a).unwrap();
+    assert_eq!(rec.info().twins_from, 2);
+    let twins = rec.twin_snapshots().unwrap();
+    let dem = rec.snapshots().unwrap();
+    assert_eq!(twins.len(), 2);
+    for (m, twin) in twins.iter().enumerate() {
+        assert_eq!(twin.iter().map(|s| s.index).collect::<Vec<_>>(), [2, 3]);
+        assert_eq!(twin[0].pos, dem[2].pos, "twin {} before it parts", m + 1);
+        assert_eq!(twin[0].temp, dem[2].temp, "twin {} before it parts", m + 1);
+        assert_ne!(twin[1].pos, dem[3].pos, "twin {} is the DEM", m + 1);
+    }
+    assert_ne!(
+        twins[0][1].pos, twins[1][1].pos,
+        "the two twins are one run"
+    );
+}

@@ -487,3 +487,110 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
         assert!(to_runs >= 0.5 * e - 1e-12, "{p}");
     }
 }
+
+/// `--twins-from 2`: the twin is the run until t2 (its stored t2 is the run's, so the floor
+/// there is nil and no ratio is taken) and parts after it; an extrapolation of both periods
+/// leaves the run at t2 too and is judged over t3, t4; one of the first period alone left
+/// the run at t1, before the twin did, and its verdict says the floor is then too narrow.
+/// A parting the run cannot give is refused before any work.
+#[test]
+fn twins_that_part_where_the_extrapolation_starts() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let rec = dir.path().join("p2.mcap");
+    let json = record(
+        &case,
+        &rec,
+        &[
+            "--recorded-periods",
+            "2",
+            "--reference",
+            "4",
+            "--twins",
+            "1",
+            "--twins-from",
+            "2",
+        ],
+    );
+    assert_eq!(json["twins"], 1, "{json}");
+    let (x2, x1) = (dir.path().join("x2.mcap"), dir.path().join("x1.mcap"));
+    extrapolate(&rec, &x2, "3", &["--jump-to", "2"]);
+    extrapolate(&rec, &x1, "3", &["--recorded-periods", "1"]);
+    let compare = |x: &Path| -> serde_json::Value {
+        serde_json::from_str(&tdex_ok(&[
+            "compare",
+            rec.to_str().unwrap(),
+            x.to_str().unwrap(),
+            "--cells",
+            "20",
+            "--json",
+        ]))
+        .unwrap()
+    };
+    let v = compare(&x2);
+    let periods = v["periods"].as_array().unwrap();
+    assert_eq!(periods[0]["k"], 2);
+    assert_eq!(periods[0]["floor_eps_abs"].as_f64(), Some(0.0), "{v}");
+    assert!(periods[0]["ratio_to_floor"].is_null(), "{v}");
+    for p in &periods[1..] {
+        assert!(p["floor_eps_abs"].as_f64().unwrap() > 0.0, "{p}");
+    }
+    assert_eq!(v["verdict"]["compared"], serde_json::json!([3, 4]), "{v}");
+    let text = v["verdict"]["text"].as_str().unwrap();
+    assert!(!text.contains("parted from the DEM at"), "{text}");
+
+    let v = compare(&x1);
+    let text = v["verdict"]["text"].as_str().unwrap();
+    assert!(
+        text.contains(
+            "the twins parted from the DEM at t2, after the extrapolation left it (t1): their \
+             spread from t3 on is narrower than a fair floor for it"
+        ),
+        "{text}"
+    );
+
+    for (flags, says) in [
+        (
+            [
+                "--recorded-periods",
+                "2",
+                "--reference",
+                "4",
+                "--twins",
+                "1",
+                "--twins-from",
+                "3",
+            ],
+            "--twins-from 3",
+        ),
+        (
+            [
+                "--recorded-periods",
+                "3",
+                "--reference",
+                "2",
+                "--twins",
+                "1",
+                "--twins-from",
+                "3",
+            ],
+            "--twins-from 3",
+        ),
+    ] {
+        let mut args = vec!["record", case.to_str().unwrap(), "-o", "never.mcap"];
+        args.extend(flags);
+        let o = run_tdex(&args);
+        assert_eq!(o.status.code(), Some(2), "{flags:?}");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.contains(says) && err.contains("at most"), "{err}");
+    }
+    let o = run_tdex(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        "never.mcap",
+        "--twins-from",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+}

@@ -60,6 +60,7 @@ fn info(recorded_periods: u32) -> RecordingInfo {
         reference_periods: 0,
         twins: 0,
         recorded_periods,
+        twins_from: 1,
         area_encoding: AreaEncoding::Exact,
         sqrt_area_unit: 0.0,
         // H m = 1e5 W/(K m) × 1e-3 m × up to 1e-4 s: c ≈ 0.02 on equal particles of 1.05 J/K

@@ -111,6 +111,17 @@ pub struct RecordArgs {
         value_parser = clap::value_parser!(u32).range(1..=tdex_format::MAX_RECORDED_PERIODS as i64)
     )]
     pub recorded_periods: u32,
+    /// The twins part from the run at t_S instead of t1 (S from 1 to P, and at most K).
+    /// An extrapolation of all P periods starts at tP: with S = P it is judged against
+    /// runs that parted where it did (`docs/user-guide.md`).
+    #[arg(
+        long = "twins-from",
+        value_name = "S",
+        default_value_t = 1,
+        requires = "twins",
+        value_parser = clap::value_parser!(u32).range(1..=tdex_format::MAX_RECORDED_PERIODS as i64)
+    )]
+    pub twins_from: u32,
     /// Worker threads (default: all cores). The recording does not depend on it.
     #[arg(long, value_parser = threads())]
     pub threads: Option<usize>,
@@ -132,7 +143,7 @@ pub struct RecordArgs {
     #[arg(
         long,
         value_name = "CHECKPOINT",
-        conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "recorded_periods", "reproducible"]
+        conflicts_with_all = ["case", "output", "tau", "tau_rev", "n", "dtc_max", "exact_area", "reference", "twins", "recorded_periods", "twins_from", "reproducible"]
     )]
     pub resume: Option<PathBuf>,
     /// Leave out the costs record (wall times, thread count): the same case, seed and

@@ -354,6 +354,17 @@ impl RecordStart {
                 }
                 options.twins = twins;
                 options.recorded_periods = args.recorded_periods;
+                let twins_from = args.twins_from;
+                let latest = args.recorded_periods.min(reference);
+                if twins > 0 && twins_from > latest {
+                    return Err(usage(format!(
+                        "--twins-from {twins_from}: the twins part from the run at a recorded \
+                         snapshot and run over at least one reference period after it, so S is \
+                         at most --recorded-periods ({}) and at most --reference ({reference})",
+                        args.recorded_periods
+                    )));
+                }
+                options.twins_from = twins_from;
                 Ok(RecordStart::Fresh {
                     case_path: case,
                     case_toml,
@@ -594,6 +605,7 @@ pub(crate) fn record_options(
         reference_periods: reference,
         twins: 0,
         recorded_periods: 1,
+        twins_from: 1,
         area_encoding,
     })
 }

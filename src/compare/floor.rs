@@ -50,8 +50,22 @@ pub enum Against {
     /// All but the reference (the first run): an extrapolation of several recorded periods
     /// is the reference itself until its first jump, so its distance to the reference has
     /// had less time to grow than the runs' distances to each other, which would flatter it.
-    /// The twins parted from that shared past at `t1`, as from each other.
+    /// The twins parted from that shared past earlier (`t1` unless recorded with
+    /// `--twins-from`), as from each other.
     AllButTheReference,
+}
+
+impl Against {
+    /// For an extrapolation that is the reference until `t_recorded_until` (its first jump;
+    /// 1 for the paper's method) of a recording whose twins part at `t_twins_from`: all runs
+    /// when it leaves the reference no later than the twins do, else all but the reference.
+    pub fn for_extrapolation(recorded_until: u32, twins_from: u32) -> Against {
+        if recorded_until >= 2 && recorded_until > twins_from {
+            Against::AllButTheReference
+        } else {
+            Against::AllRuns
+        }
+    }
 }
 
 /// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
@@ -133,6 +147,22 @@ pub fn median(values: &[f64]) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_reference_is_left_out_only_when_the_extrapolation_follows_it_past_the_twins_parting() {
+        use Against::*;
+        // the paper's method, and twins that part where the extrapolation starts
+        assert_eq!(Against::for_extrapolation(1, 1), AllRuns);
+        assert_eq!(Against::for_extrapolation(2, 2), AllRuns);
+        assert_eq!(Against::for_extrapolation(3, 3), AllRuns);
+        // an extrapolation that starts before the twins part (its verdict says so)
+        assert_eq!(Against::for_extrapolation(1, 2), AllRuns);
+        // several recorded periods, twins from t1 or from a snapshot before the start
+        assert_eq!(Against::for_extrapolation(2, 1), AllButTheReference);
+        assert_eq!(Against::for_extrapolation(3, 2), AllButTheReference);
+        // a path that never jumps (u32::MAX) stays the reference throughout
+        assert_eq!(Against::for_extrapolation(u32::MAX, 4), AllButTheReference);
+    }
+
     use super::*;
 
     fn cells() -> Cells {

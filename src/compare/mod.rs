@@ -395,14 +395,12 @@ pub fn compare_runs(
         (None, None) => ContrastKind::None,
     };
 
-    // An extrapolation that follows the reference past t1 (several recorded periods) is
-    // measured against the runs that parted from that shared past at t1: the twins and any
-    // further runs, not the reference (floor::Against).
-    let against = if recorded_until >= 2 {
-        floor::Against::AllButTheReference
-    } else {
-        floor::Against::AllRuns
-    };
+    // An extrapolation that follows the reference past the twins' parting t_s (several
+    // recorded periods, twins from t1) is measured against the runs that parted from that
+    // shared past at t_s: the twins and any further runs, not the reference
+    // (floor::Against). One that leaves the reference where the twins do is one more run.
+    let twins_from = recording.info().twins_from;
+    let against = floor::Against::for_extrapolation(recorded_until, twins_from);
 
     // The extrapolated positions are the roles' positions at the end of the recorded period
     // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
@@ -553,7 +551,20 @@ pub fn compare_runs(
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
-    let verdict = Verdict::of(&periods, 1 + others.len(), contrast_kind);
+    let mut verdict = Verdict::of(&periods, 1 + others.len(), contrast_kind);
+    if (1..twins_from).contains(&recorded_until)
+        && !others.is_empty()
+        && verdict.median_ratio.is_some()
+    {
+        // the twins followed the reference past the extrapolation's start: their distances
+        // to it have had less time to grow than the extrapolation's
+        verdict.text.push_str(&format!(
+            "; the twins parted from the DEM at t{twins_from}, after the extrapolation left it \
+             (t{}): their spread from t{} on is narrower than a fair floor for it",
+            recorded_until,
+            twins_from + 1
+        ));
+    }
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,

@@ -180,6 +180,14 @@ pub struct RecordingInfo {
     /// method), so that such a recording is the same bytes as before the field existed.
     #[serde(default = "one", skip_serializing_if = "is_one")]
     pub recorded_periods: u32,
+    /// The recorded snapshot `t_s` the DEM twins part from the run at (`--twins-from s`,
+    /// 1 ≤ s ≤ P and s ≤ K). Until `t_s` a twin *is* the run, so its snapshots `t2 … t_s`
+    /// are the run's, stored again so that every run holds `t2 … t(K+1)`. `s = P` puts the
+    /// twins' parting where an extrapolation of all `P` periods starts. Absent from the JSON
+    /// when 1 (the twins part at `t1`), so that such a recording is the same bytes as before
+    /// the field existed.
+    #[serde(default = "one", skip_serializing_if = "is_one")]
+    pub twins_from: u32,
     pub area_encoding: AreaEncoding,
     /// Metres per `sqrt(a)` code (quantised encoding), else 0.
     pub sqrt_area_unit: f64,
@@ -252,6 +260,21 @@ impl RecordingInfo {
                 &format!(
                     "must be at most {MAX_TWINS}, and 0 without reference periods (here {})",
                     self.reference_periods
+                ),
+            );
+        }
+        let latest_parting = if self.twins == 0 {
+            1
+        } else {
+            self.recorded_periods.min(self.reference_periods)
+        };
+        if !(1..=latest_parting.max(1)).contains(&self.twins_from) {
+            return bad(
+                "twins_from",
+                &self.twins_from,
+                &format!(
+                    "must be between 1 and the recorded periods and the reference periods,                      whichever is fewer (here {}), and 1 without twins",
+                    latest_parting.max(1)
                 ),
             );
         }

@@ -96,6 +96,7 @@ pub fn import(
         twins: 0,
         // the dumps hold one period
         recorded_periods: 1,
+        twins_from: 1,
         ..opts.clone()
     };
     let info = recording_info(case, case_path, case_toml, &opts, run);

@@ -369,7 +369,7 @@ impl Checkpoint<'static> {
                 }
                 // the state at t1 is kept from t1 on while twins are still to run from it
                 let keeps_t1 = match self.stage {
-                    Stage::Period { period, .. } => period > 0 && o.twins > 0,
+                    Stage::Period { period, .. } => period >= o.twins_from && o.twins > 0,
                     Stage::Reference { .. } => o.twins > 0,
                     Stage::Twin { .. } => true,
                     _ => false,

@@ -247,6 +247,14 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
             tdex_format::MAX_TWINS
         )));
     }
+    let latest = opts.recorded_periods.min(opts.reference_periods).max(1);
+    if !(1..=latest).contains(&opts.twins_from) || (opts.twins == 0 && opts.twins_from != 1) {
+        return Err(RecordError::Settings(format!(
+            "twins parting at t{}: DEM twins part from the run at a recorded snapshot, t1 to \
+             t{latest} here ({} recorded, {} reference periods), and at t1 without twins",
+            opts.twins_from, opts.recorded_periods, opts.reference_periods
+        )));
+    }
     ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
         RecordError::Settings(format!(
             "Δt_c^max = {} steps must be a positive multiple of n = {}",
@@ -489,8 +497,21 @@ fn drive(
     // seconds `elapsed.recorder` carries
     let mut recorder_seconds = vec![elapsed.recorder; sinks.len()];
 
-    // DEM twins are checked against the run's t2 (a recorded snapshot when P ≥ 2)
-    let mut dem_t2 = snapshots.get(2).filter(|_| opts.twins > 0).cloned();
+    // DEM twins part from the run at t_s (s = `twins_from`): until there a twin is the run,
+    // so its snapshots t2 … t_s are the run's (kept here), and its first own one, t_(s+1),
+    // is checked against the run's
+    let parting = opts.twins_from;
+    let own = opts.last_snapshot() as usize + 1;
+    let mut before_parting: Vec<Snapshot> = snapshots
+        .iter()
+        .take(own)
+        .filter(|s| opts.twins > 0 && (2..=parting).contains(&s.index))
+        .cloned()
+        .collect();
+    let mut dem_t2 = snapshots
+        .get(parting as usize + 1)
+        .filter(|_| opts.twins > 0)
+        .cloned();
 
     // the recorded periods, one after the other: the samplers are cut at each boundary
     if let Stage::Period {
@@ -543,10 +564,13 @@ fn drive(
                 sink.writer.write_snapshot(&snapshot)?;
                 *seconds += busy + t.elapsed().as_secs_f64();
             }
-            if index == 0 && opts.twins > 0 {
+            if index + 1 == parting && opts.twins > 0 {
                 at_t1 = Some(sim.clone());
             }
-            if snapshot.index == 2 && opts.twins > 0 {
+            if (2..=parting).contains(&snapshot.index) && opts.twins > 0 {
+                before_parting.push(snapshot.clone());
+            }
+            if snapshot.index == parting + 1 && opts.twins > 0 {
                 dem_t2 = Some(snapshot.clone());
             }
             // kept only for the checkpoints: a snapshot is 68 B a particle
@@ -598,7 +622,7 @@ fn drive(
                     for sink in sinks.iter_mut() {
                         sink.writer.write_snapshot(snapshot)?;
                     }
-                    if snapshot.index == 2 && opts.twins > 0 {
+                    if snapshot.index == parting + 1 && opts.twins > 0 {
                         dem_t2 = Some(snapshot.clone());
                     }
                     Ok(())
@@ -628,11 +652,24 @@ fn drive(
                 if twin != first {
                     *sim = twin_of(t1, twin);
                 }
-                let from = if twin == first {
+                let mut from = if twin == first {
                     (first_period, done)
                 } else {
                     (0, 0)
                 };
+                // before it parts the twin is the run: the run's snapshots t2 … t_s, stored
+                // as the twin's so that every run holds t2 … t(K+1)
+                if from.0 + 1 < parting {
+                    for snapshot in &before_parting[from.0 as usize..] {
+                        for sink in sinks.iter_mut() {
+                            sink.writer.write_twin_snapshot(twin, snapshot)?;
+                        }
+                        if past_t1.saver.is_some() {
+                            snapshots.push(snapshot.clone());
+                        }
+                    }
+                    from = (parting - 1, 0);
+                }
                 past_t1.periods(
                     sim,
                     Continuation::Twin(twin),
@@ -640,7 +677,7 @@ fn drive(
                     &mut snapshots,
                     progress,
                     &mut |period, snapshot| {
-                        if period == 0 {
+                        if period + 1 == parting {
                             check_twin_differs(twin, snapshot, dem_t2.as_ref())?;
                         }
                         for sink in sinks.iter_mut() {

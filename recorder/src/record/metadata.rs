@@ -87,6 +87,7 @@ pub(crate) fn recording_info(
         reference_periods: opts.reference_periods,
         twins: opts.twins,
         recorded_periods: opts.recorded_periods,
+        twins_from: opts.twins_from,
         area_encoding: opts.area_encoding,
         sqrt_area_unit: match opts.area_encoding {
             AreaEncoding::Quantized => std::f64::consts::PI.sqrt() * run.r_max / SQRT_AREA_CODES,

@@ -22,7 +22,16 @@ pub struct RecordOptions {
     /// Consecutive periods recorded from `t0` (`P`, 1 to [`tdex_format::MAX_RECORDED_PERIODS`]):
     /// `P` collision tables, one after the other, and the snapshots `t0 … tP`.
     pub recorded_periods: u32,
+    /// The recorded snapshot `t_s` the twins part from the run at (1 to `P`, and at most the
+    /// reference periods): until there a twin is the run. 1 in checkpoints written before the
+    /// field existed.
+    #[serde(default = "one")]
+    pub twins_from: u32,
     pub area_encoding: AreaEncoding,
+}
+
+fn one() -> u32 {
+    1
 }
 
 impl RecordOptions {
