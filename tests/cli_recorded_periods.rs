@@ -540,6 +540,15 @@ fn twins_that_part_where_the_extrapolation_starts() {
     assert!(!text.contains("parted from the DEM at"), "{text}");
 
     let v = compare(&x1);
+    // t2, where the runs are still one, has no floor: neither a ratio nor a range to leave
+    assert_eq!(v["verdict"]["compared"], serde_json::json!([3, 4]), "{v}");
+    assert!(
+        !v["verdict"]["outside_range"]
+            .as_array()
+            .unwrap()
+            .contains(&serde_json::json!(2)),
+        "{v}"
+    );
     let text = v["verdict"]["text"].as_str().unwrap();
     assert!(
         text.contains(

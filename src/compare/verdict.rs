@@ -144,9 +144,11 @@ impl Verdict {
             .collect();
         let ratios: Vec<f64> = rated.iter().map(|r| r.1).collect();
         let compared: Vec<u32> = rated.iter().map(|r| r.0).collect();
+        // only where there is a ratio: before the twins part (`--twins-from`) the runs are
+        // one, and there is no range to be outside of
         let outside_range: Vec<u32> = periods
             .iter()
-            .filter(|p| p.outside_floor_range())
+            .filter(|p| p.ratio_to_floor.is_some() && p.outside_floor_range())
             .map(|p| p.k)
             .collect();
         // group means (bed mean for a bed without groups): the extrapolation's error and the

@@ -1,0 +1,42 @@
+#!/usr/bin/env python3
+"""Draws from t2 judged against twins that part at t2 (docs/validation.md, "Twins that part
+where the extrapolation starts"). (diagnostic)
+
+usage: fair_start_summary.py DIR BED [BED ...]
+       DIR holds, for every BED (a seed), `tdex compare --json` outputs of the recording fBED.mcap
+       (`--recorded-periods 2 --reference 7 --twins 3 --twins-from 2`): fBED_c.json (the second
+       revolution repeated, `--jump-to 2`), fBED_d.json and fBED_e.json (two revolutions, the
+       default path and `--seed 1`'s), fBED_b.json (one revolution from t1, `--recorded-periods 1`).
+
+Prints each draw's median ratio over t3…t8, each DEM run's own median judged against the
+other three over the same t_k (compare's verdict.dem_runs_median_ratio), and the means.
+"""
+import json
+import statistics as st
+import sys
+
+DRAWS = {"b": "one revolution from t1", "c": "the second revolution repeated",
+         "d": "two revolutions, default path", "e": "two revolutions, seed 1's path"}
+
+
+def main(folder, beds):
+    draws = {m: [] for m in DRAWS}
+    runs = []
+    for b in beds:
+        line = []
+        for m in DRAWS:
+            v = json.load(open(f"{folder}/f{b}_{m}.json"))["verdict"]
+            draws[m].append(v["median_ratio"])
+            line.append(f"{m} {v['median_ratio']:.2f}")
+        seat = v["dem_runs_median_ratio"]
+        runs += seat
+        print(f"bed {b}: " + ", ".join(line) + "; DEM runs in the seat " + " ".join(f"{x:.2f}" for x in seat))
+    for m, name in DRAWS.items():
+        xs = draws[m]
+        print(f"{name}: mean {st.mean(xs):.3f}, {min(xs):.2f}–{max(xs):.2f}, {sum(x <= 1 for x in xs)} of {len(xs)} at most 1")
+    print(f"a DEM run in the seat: mean {st.mean(runs):.3f}, median {st.median(runs):.3f}, "
+          f"{min(runs):.2f}–{max(runs):.2f}, {sum(x <= 1 for x in runs)} of {len(runs)} at most 1")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1], sys.argv[2:])
