@@ -41,6 +41,13 @@ fn main() -> ExitCode {
     unsafe {
         libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
     }
+    // Rust ignores SIGPIPE, so `tdex inspect run.mcap | head` would panic on its next print
+    // once `head` has gone; the default disposition ends tdex quietly there, as any Unix
+    // tool. tdex writes no pipe of its own (files go to a temporary file and are renamed).
+    // SAFETY: as above, before any thread starts.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let args = cli::Cli::parse_args();
     let result = cli::Plan::from_args(args).and_then(|plan| match plan {
         cli::Plan::Run(p) => run::run(&p),

@@ -267,3 +267,25 @@ fn temperatures_are_refused_in_kelvin() {
         );
     }
 }
+
+/// `tdex inspect run.mcap | head -1`: once the reader has gone, tdex ends quietly on the
+/// broken pipe (SIGPIPE, as any Unix tool), not with a panic on its first print. The read
+/// end is closed before tdex has read the file, so no print can reach the pipe in time.
+#[test]
+fn a_reader_that_stops_early_ends_inspect_quietly() {
+    use std::os::unix::process::ExitStatusExt;
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().unwrap();
+    let (run, _) = heated(dir.path());
+    let mut child = Command::new(tdex())
+        .args(["inspect", run.to_str().unwrap()])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.is_empty(), "{err}");
+    assert_eq!(out.status.signal(), Some(libc::SIGPIPE), "{:?}", out.status);
+}
