@@ -341,16 +341,14 @@ fn an_extrapolation_of_another_recording_of_the_run_is_compared_at_the_shared_in
     );
 }
 
-/// A recording with one real DEM twin: `compare` measures the floor between the DEM and
-/// the twin at every t_k, the extrapolation's distance to both runs and the ratio, and says
-/// its verdict; the twin is stored in the recording, found without extra arguments.
-#[test]
-fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
-    let dir = tempfile::tempdir().unwrap();
-    let case = dir.path().join("case.toml");
+/// The tiny drum recorded for τ = a quarter revolution with 3 reference periods and `twins`
+/// DEM twins, extrapolated 3 periods: (recording, extrapolation) in `dir`.
+fn record_twins_and_extrapolate(dir: &Path, twins: u32) -> (PathBuf, PathBuf) {
+    let case = dir.join("case.toml");
     std::fs::write(&case, TINY_CASE).unwrap();
-    let (run, extra) = (dir.path().join("run.mcap"), dir.path().join("extra.mcap"));
+    let (run, extra) = (dir.join("run.mcap"), dir.join("extra.mcap"));
     let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    let twins = twins.to_string();
     tdex_ok(&[
         "record",
         case.to_str().unwrap(),
@@ -361,9 +359,20 @@ fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
         "--reference",
         "3",
         "--twins",
-        "1",
+        &twins,
     ]);
     tdex_ok(&["extrapolate", run_s, "--periods", "3", "-o", extra_s]);
+    (run, extra)
+}
+
+/// A recording with one real DEM twin: `compare` measures the floor between the DEM and
+/// the twin at every t_k, the extrapolation's distance to both runs and the ratio, and says
+/// its verdict; the twin is stored in the recording, found without extra arguments.
+#[test]
+fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, extra) = record_twins_and_extrapolate(dir.path(), 1);
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
     let twins = RecordingReader::open(&run)
         .unwrap()
         .twin_snapshots()
@@ -465,23 +474,8 @@ fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
 #[test]
 fn with_three_dem_runs_each_run_is_judged_against_the_others() {
     let dir = tempfile::tempdir().unwrap();
-    let case = dir.path().join("case.toml");
-    std::fs::write(&case, TINY_CASE).unwrap();
-    let (run, extra) = (dir.path().join("run.mcap"), dir.path().join("extra.mcap"));
+    let (run, extra) = record_twins_and_extrapolate(dir.path(), 2);
     let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
-    tdex_ok(&[
-        "record",
-        case.to_str().unwrap(),
-        "-o",
-        run_s,
-        "--tau-rev",
-        "0.25",
-        "--reference",
-        "3",
-        "--twins",
-        "2",
-    ]);
-    tdex_ok(&["extrapolate", run_s, "--periods", "3", "-o", extra_s]);
     let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();

@@ -251,6 +251,19 @@ fn extrapolated(path: &Path) -> Vec<tdex_format::Snapshot> {
         .unwrap()
 }
 
+/// `tdex compare rec x --cells 20 --json`.
+fn compare_json(rec: &Path, x: &Path) -> serde_json::Value {
+    serde_json::from_str(&tdex_ok(&[
+        "compare",
+        rec.to_str().unwrap(),
+        x.to_str().unwrap(),
+        "--cells",
+        "20",
+        "--json",
+    ]))
+    .unwrap()
+}
+
 /// `tdex extrapolate` of `rec` over `periods` into `out`, reproducibly; its `--json`.
 fn extrapolate(rec: &Path, out: &Path, periods: &str, extra: &[&str]) -> serde_json::Value {
     let mut args = vec![
@@ -407,17 +420,7 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
     let path = extrapolate(&rec, &x2, "3", &["--jump-to", "2"]);
     assert_eq!(path["path"]["replayed"], serde_json::json!([2, 2, 2]));
     extrapolate(&rec, &x1, "3", &["--recorded-periods", "1"]);
-    let compare = |x: &Path| -> serde_json::Value {
-        serde_json::from_str(&tdex_ok(&[
-            "compare",
-            rec.to_str().unwrap(),
-            x.to_str().unwrap(),
-            "--cells",
-            "20",
-            "--json",
-        ]))
-        .unwrap()
-    };
+    let compare = |x: &Path| compare_json(&rec, x);
     let ks = |v: &serde_json::Value, key: &str| -> Vec<u64> {
         v["verdict"][key]
             .as_array()
@@ -516,17 +519,7 @@ fn twins_that_part_where_the_extrapolation_starts() {
     let (x2, x1) = (dir.path().join("x2.mcap"), dir.path().join("x1.mcap"));
     extrapolate(&rec, &x2, "3", &["--jump-to", "2"]);
     extrapolate(&rec, &x1, "3", &["--recorded-periods", "1"]);
-    let compare = |x: &Path| -> serde_json::Value {
-        serde_json::from_str(&tdex_ok(&[
-            "compare",
-            rec.to_str().unwrap(),
-            x.to_str().unwrap(),
-            "--cells",
-            "20",
-            "--json",
-        ]))
-        .unwrap()
-    };
+    let compare = |x: &Path| compare_json(&rec, x);
     let v = compare(&x2);
     let periods = v["periods"].as_array().unwrap();
     assert_eq!(periods[0]["k"], 2);
