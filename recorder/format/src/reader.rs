@@ -137,7 +137,8 @@ impl RecordingReader {
     }
 
     /// The DEM twins' reference snapshots: entry `m - 1` holds twin `m`'s, by index
-    /// (`t2` on: a twin parts from the DEM at `t1`). Empty without twins.
+    /// (`t2` on: a twin parts from the DEM at `t1`, or at `t_s` with `twins_from` = s, when its
+    /// snapshots up to `t_s` are the DEM's). Empty without twins.
     pub fn twin_snapshots(&self) -> Result<Vec<Vec<Snapshot>>, FormatError> {
         let twins: Vec<Vec<Snapshot>> = self
             .twin_channels
