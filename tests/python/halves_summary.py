@@ -12,10 +12,17 @@ usage: halves_summary.py DIR BED [BED ...]
 Each draw's median ratio_to_floor is over the six whole revolutions after its start
 (k = H+2, H+4, …, H+12 in half revolutions), the instants of the one-revolution draws; a
 genuine DEM run judged in the extrapolation's seat (run_as_candidate.py) over the same k.
+Then, per bed, how far the reference and the twins part (mean particle distance, diameters,
+and mean cell distance, K, reference to twins against twin to twin), and, where DIR holds
+vBED.mcap (`tdex record small_drum_seedBED.toml -o vBED.mcap`, τ = one revolution), whether
+its t1 is hBED.mcap's t2 bit for bit: the same DEM run, whatever τ.
 """
 import json
+import os
 import statistics as st
 import sys
+
+import numpy as np
 
 import run_as_candidate
 from draw_summary import above, describe
@@ -67,5 +74,32 @@ def main(folder, beds):
                   f"lower in {sum(d < -0.005 for d in diff)} of {len(diff)}")
 
 
+def parting(folder, beds):
+    for b in beds:
+        runs = run_as_candidate.runs_at(f"{folder}/h{b}.mcap")
+        ref = runs[0]
+        bed1 = np.stack([ref[1][f] for f in "xyz"], 1)
+        seeds = run_as_candidate.cells_inside_bed(bed1, ref[1]["r"].max(), 200, 1)
+        diameter = 2 * ref[1]["r"].max()
+        twins = [m for m in runs if m != 0]
+        pairs = [(a, c) for i, a in enumerate(twins) for c in twins[i + 1:]]
+        line = []
+        for k in (2, 16, 20):
+            pos = {m: np.stack([runs[m][k][f] for f in "xyz"], 1) for m in runs}
+            apart = lambda a, c: np.sqrt(((pos[a] - pos[c]) ** 2).sum(1)).mean() / diameter
+            means = {m: run_as_candidate.cell_means(seeds, runs[m][k]) for m in runs}
+            cell = lambda a, c: run_as_candidate.eps_abs(means[a], means[c])
+            line.append(f"t{k}: {st.mean(apart(0, m) for m in twins):.2f} / "
+                        f"{st.mean(apart(a, c) for a, c in pairs):.2f} d, "
+                        f"{st.mean(cell(0, m) for m in twins):.3f} / {st.mean(cell(a, c) for a, c in pairs):.3f} K")
+        print(f"bed {b}, reference to twins / twin to twin: " + "; ".join(line))
+        whole = f"{folder}/v{b}.mcap"
+        if os.path.exists(whole):
+            one = run_as_candidate.runs_at(whole)[0][1]
+            same = all(np.array_equal(one[f], ref[2][f]) for f in ("x", "y", "z", "T"))
+            print(f"  {whole}'s t1 is h{b}.mcap's t2 bit for bit: {same}")
+
+
 if __name__ == "__main__":
     main(sys.argv[1], sys.argv[2:])
+    parting(sys.argv[1], sys.argv[2:])
