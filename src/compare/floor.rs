@@ -147,10 +147,12 @@ pub fn median(values: &[f64]) -> Option<f64> {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn the_reference_is_left_out_only_when_the_extrapolation_follows_it_past_the_twins_parting() {
-        use Against::*;
         // the paper's method, and twins that part where the extrapolation starts
+        use Against::{AllButTheReference, AllRuns};
         assert_eq!(Against::for_extrapolation(1, 1), AllRuns);
         assert_eq!(Against::for_extrapolation(2, 2), AllRuns);
         assert_eq!(Against::for_extrapolation(3, 3), AllRuns);
@@ -162,8 +164,6 @@ mod tests {
         // a path that never jumps (u32::MAX) stays the reference throughout
         assert_eq!(Against::for_extrapolation(u32::MAX, 4), AllButTheReference);
     }
-
-    use super::*;
 
     fn cells() -> Cells {
         Cells::from_seeds(vec![[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
