@@ -595,4 +595,22 @@ fn twins_that_part_where_the_extrapolation_starts() {
         "2",
     ]);
     assert_eq!(o.status.code(), Some(2));
+    let o = run_tdex(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        "never.mcap",
+        "--reference",
+        "4",
+        "--twins",
+        "0",
+        "--twins-from",
+        "2",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("--twins-from 2 with --twins 0") && err.contains("give --twins M"),
+        "{err}"
+    );
 }

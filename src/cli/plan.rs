@@ -355,8 +355,15 @@ impl RecordStart {
                 options.twins = twins;
                 options.recorded_periods = args.recorded_periods;
                 let twins_from = args.twins_from;
-                let latest = args.recorded_periods.min(reference);
-                if twins > 0 && twins_from > latest {
+                let latest =
+                    tdex_format::latest_twins_parting(args.recorded_periods, reference, twins);
+                if twins == 0 && twins_from > 1 {
+                    return Err(usage(format!(
+                        "--twins-from {twins_from} with --twins 0: there are no twins to part \
+                         from the run; give --twins M (at least 1) or leave --twins-from out"
+                    )));
+                }
+                if twins_from > latest {
                     return Err(usage(format!(
                         "--twins-from {twins_from}: the twins part from the run at a recorded \
                          snapshot and run over at least one reference period after it, so S is \

@@ -68,6 +68,35 @@ impl Against {
     }
 }
 
+/// Where the twins parted from the reference, against where the second field left it: whether
+/// their spread is a fair floor for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Parting {
+    /// No later than the second field left the reference (or it is a DEM run): the twins
+    /// have been apart as long as it has.
+    NoLater,
+    /// At `t_parted`, after the extrapolation left the reference at `t_left`
+    /// (`--twins-from` later than its start): the twins followed the reference past the
+    /// extrapolation's start, so their distances to it have had less time to grow than the
+    /// extrapolation's, and their floor is narrower than a fair one for it.
+    After { left: u32, parted: u32 },
+}
+
+impl Parting {
+    /// For an extrapolation that is the reference until `t_recorded_until` (0 for a DEM run)
+    /// of a recording whose twins part at `t_twins_from`.
+    pub fn of(recorded_until: u32, twins_from: u32) -> Parting {
+        if (1..twins_from).contains(&recorded_until) {
+            Parting::After {
+                left: recorded_until,
+                parted: twins_from,
+            }
+        } else {
+            Parting::NoLater
+        }
+    }
+}
+
 /// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
 /// the distance of `second` (cell means already computed) to those `against` names, on
 /// `cells`. `None` with fewer than two runs or when no cell holds particles of both fields
@@ -163,6 +192,16 @@ mod tests {
         assert_eq!(Against::for_extrapolation(3, 2), AllButTheReference);
         // a path that never jumps (u32::MAX) stays the reference throughout
         assert_eq!(Against::for_extrapolation(u32::MAX, 4), AllButTheReference);
+    }
+
+    #[test]
+    fn the_twins_part_late_only_after_an_extrapolation_left_the_reference() {
+        assert_eq!(Parting::of(1, 2), Parting::After { left: 1, parted: 2 });
+        assert_eq!(Parting::of(2, 3), Parting::After { left: 2, parted: 3 });
+        for (recorded_until, twins_from) in [(1, 1), (2, 2), (3, 2), (u32::MAX, 4), (0, 3)] {
+            // 0: a second DEM run, which never was the reference
+            assert_eq!(Parting::of(recorded_until, twins_from), Parting::NoLater);
+        }
     }
 
     fn cells() -> Cells {

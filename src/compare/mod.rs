@@ -551,20 +551,12 @@ pub fn compare_runs(
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
-    let mut verdict = Verdict::of(&periods, 1 + others.len(), contrast_kind);
-    if (1..twins_from).contains(&recorded_until)
-        && !others.is_empty()
-        && verdict.median_ratio.is_some()
-    {
-        // the twins followed the reference past the extrapolation's start: their distances
-        // to it have had less time to grow than the extrapolation's
-        verdict.text.push_str(&format!(
-            "; the twins parted from the DEM at t{twins_from}, after the extrapolation left it \
-             (t{}): their spread from t{} on is narrower than a fair floor for it",
-            recorded_until,
-            twins_from + 1
-        ));
-    }
+    let verdict = Verdict::of(
+        &periods,
+        1 + others.len(),
+        floor::Parting::of(recorded_until, twins_from),
+        contrast_kind,
+    );
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,

@@ -2,7 +2,7 @@
 //! pass as one more DEM run of the case (median ratio to their spread ≤ 1 and, with three
 //! or more DEM runs, within their own range at every compared `t_k`)?
 
-use super::floor::median;
+use super::floor::{median, Parting};
 use super::{ContrastKind, PeriodComparison};
 use serde::Serialize;
 
@@ -129,7 +129,15 @@ impl Verdict {
     /// in law misses at about half of them: the median alone decides, and the `t_k` above
     /// 1 are named. The `t_k` where the extrapolation was still the recorded run
     /// ([`PeriodComparison::within_recording`]) are left out: there it is the DEM itself.
-    pub fn of(periods: &[PeriodComparison], dem_runs: usize, contrast: ContrastKind) -> Self {
+    /// Where the twins parted from the reference after the extrapolation left it
+    /// ([`Parting::After`]), the judgement stands but says its floor is narrower than a fair
+    /// one.
+    pub fn of(
+        periods: &[PeriodComparison],
+        dem_runs: usize,
+        parting: Parting,
+        contrast: ContrastKind,
+    ) -> Self {
         let within_recording: Vec<u32> = periods
             .iter()
             .filter(|p| p.within_recording)
@@ -226,10 +234,19 @@ impl Verdict {
                 instants(&within_recording, within_recording.len())
             )
         };
+        let late_parting = match parting {
+            Parting::After { left, parted } if dem_runs > 1 && median_ratio.is_some() => format!(
+                "; the twins parted from the DEM at t{parted}, after the extrapolation left it \
+                 (t{left}): their spread from t{} on is narrower than a fair floor for it",
+                parted + 1
+            ),
+            _ => String::new(),
+        };
         let text = match (passes, median_ratio) {
             (Some(true), Some(m)) => format!(
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}",
+                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}\
+                 {late_parting}",
                 instants(&compared, compared.len()),
                 beside_one(m),
                 if outside_range.is_empty() {
@@ -272,7 +289,8 @@ impl Verdict {
                 };
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}",
+                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}\
+                     {late_parting}",
                     instants(&compared, compared.len()),
                     if m > 1.0 {
                         format!("{} > 1", above_one(m))
@@ -378,7 +396,7 @@ mod tests {
             .zip(ratios)
             .map(|(k, &r)| period(k, r, spread))
             .collect();
-        Verdict::of(&periods, dem_runs, ContrastKind::HotCold)
+        Verdict::of(&periods, dem_runs, Parting::NoLater, ContrastKind::HotCold)
     }
 
     /// With one twin the range is the one pair's distance, so a ratio above 1 at some t_k
@@ -420,14 +438,14 @@ mod tests {
             .map(|(&r, k)| period(k, r, 1.0))
             .collect();
         periods[0].within_recording = true;
-        let v = Verdict::of(&periods, 2, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 2, Parting::NoLater, ContrastKind::HotCold);
         assert_eq!(v.within_recording, vec![2]);
         assert_eq!(v.compared, vec![3, 4, 5]);
         assert_eq!(v.median_ratio, Some(1.02));
         assert_eq!(v.passes, Some(false), "{}", v.text);
         assert!(v.text.contains("over t3…t5"), "{}", v.text);
         assert!(v.text.contains("t2 left out"), "{}", v.text);
-        let v = Verdict::of(&periods[..1], 2, ContrastKind::HotCold);
+        let v = Verdict::of(&periods[..1], 2, Parting::NoLater, ContrastKind::HotCold);
         assert_eq!(v.passes, None);
         assert!(
             v.text.starts_with("not judged: at every compared t_k (t2)"),
@@ -465,7 +483,7 @@ mod tests {
         for (p, straggler) in periods.iter_mut().zip([1.2, 1.4, 1.3, 1.3, 1.5, 1.1]) {
             p.dem_runs_ratio_to_others = vec![Some(0.8), Some(0.9), Some(1.0), Some(straggler)];
         }
-        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio, vec![0.8, 0.9, 1.0, 1.3]);
         assert!(
             v.text
@@ -476,13 +494,39 @@ mod tests {
         // the recorded stretch is left out of the runs' medians as of the extrapolation's
         periods[0].within_recording = true;
         periods[0].dem_runs_ratio_to_others[3] = Some(9.0);
-        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio[3], 1.3);
         // a run missing at one compared t_k: no medians, and nothing said
         periods[2].dem_runs_ratio_to_others.pop();
-        let v = Verdict::of(&periods, 4, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
         assert!(v.dem_runs_median_ratio.is_empty());
         assert!(!v.text.contains("each DEM run"), "{}", v.text);
+    }
+
+    /// Twins that parted after the extrapolation left the reference: the judgement stands
+    /// and says why its floor is narrow; with one DEM run there is no floor to qualify.
+    #[test]
+    fn a_late_parting_is_said_beside_the_judgement() {
+        let periods: Vec<PeriodComparison> = [0.96, 1.04, 0.9]
+            .iter()
+            .zip(2..)
+            .map(|(&r, k)| period(k, r, 1.0))
+            .collect();
+        let late = Parting::After { left: 1, parted: 2 };
+        let fair = Verdict::of(&periods, 2, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 2, late, ContrastKind::HotCold);
+        assert_eq!(v.passes, fair.passes);
+        assert_eq!(v.median_ratio, fair.median_ratio);
+        assert_eq!(
+            v.text,
+            format!(
+                "{}; the twins parted from the DEM at t2, after the extrapolation left it (t1): \
+                 their spread from t3 on is narrower than a fair floor for it",
+                fair.text
+            )
+        );
+        let alone = Verdict::of(&periods, 1, late, ContrastKind::HotCold);
+        assert!(!alone.text.contains("twins parted"), "{}", alone.text);
     }
 
     #[test]

@@ -45,6 +45,18 @@ pub fn twin_topic(twin: u32) -> String {
 pub const MAX_TWINS: u32 = 16;
 /// Most consecutive periods one recording may hold (`--recorded-periods P`).
 pub const MAX_RECORDED_PERIODS: u32 = 64;
+/// The latest recorded snapshot `t_s` that DEM twins may part from the run at
+/// (`--twins-from s`): a twin parts at a recorded snapshot and runs over at least one
+/// reference period after it, so s ≤ min(recorded periods, reference periods); without twins
+/// nothing parts, and s is 1. Shared by the CLI, the recorder and the reader so that their
+/// ranges agree.
+pub fn latest_twins_parting(recorded_periods: u32, reference_periods: u32, twins: u32) -> u32 {
+    if twins == 0 {
+        1
+    } else {
+        recorded_periods.min(reference_periods).max(1)
+    }
+}
 /// Channel of the collision table (`tdex.CollisionBatch`).
 pub const COLLISION_TOPIC: &str = "/tdex/collisions";
 /// Metadata record written first: [`RecordingInfo`] as JSON under the key `json`.
@@ -263,18 +275,15 @@ impl RecordingInfo {
                 ),
             );
         }
-        let latest_parting = if self.twins == 0 {
-            1
-        } else {
-            self.recorded_periods.min(self.reference_periods)
-        };
-        if !(1..=latest_parting.max(1)).contains(&self.twins_from) {
+        let latest_parting =
+            latest_twins_parting(self.recorded_periods, self.reference_periods, self.twins);
+        if !(1..=latest_parting).contains(&self.twins_from) {
             return bad(
                 "twins_from",
                 &self.twins_from,
                 &format!(
-                    "must be between 1 and the recorded periods and the reference periods,                      whichever is fewer (here {}), and 1 without twins",
-                    latest_parting.max(1)
+                    "must be between 1 and the recorded periods and the reference periods, \
+                     whichever is fewer (here {latest_parting}), and 1 without twins"
                 ),
             );
         }
@@ -502,5 +511,21 @@ impl Classify for FormatError {
             }
             _ => Fault::Input,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::latest_twins_parting;
+
+    #[test]
+    fn twins_part_at_most_where_both_the_recording_and_the_reference_reach() {
+        assert_eq!(latest_twins_parting(2, 6, 1), 2);
+        assert_eq!(latest_twins_parting(3, 2, 2), 2);
+        assert_eq!(latest_twins_parting(1, 6, 1), 1);
+        // without twins nothing parts, whatever the periods
+        assert_eq!(latest_twins_parting(4, 6, 0), 1);
+        // no reference periods: no twins either, but never a range that excludes t1
+        assert_eq!(latest_twins_parting(2, 0, 1), 1);
     }
 }

@@ -247,8 +247,12 @@ fn check(opts: &RecordOptions) -> Result<ContactSampler, RecordError> {
             tdex_format::MAX_TWINS
         )));
     }
-    let latest = opts.recorded_periods.min(opts.reference_periods).max(1);
-    if !(1..=latest).contains(&opts.twins_from) || (opts.twins == 0 && opts.twins_from != 1) {
+    let latest = tdex_format::latest_twins_parting(
+        opts.recorded_periods,
+        opts.reference_periods,
+        opts.twins,
+    );
+    if !(1..=latest).contains(&opts.twins_from) {
         return Err(RecordError::Settings(format!(
             "twins parting at t{}: DEM twins part from the run at a recorded snapshot, t1 to \
              t{latest} here ({} recorded, {} reference periods), and at t1 without twins",
