@@ -2,7 +2,8 @@
 //! command that runs the DEM.
 
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
-use recorder::record::Phase;
+use recorder::record::{Phase, REPORT_EVERY};
+use std::time::{Duration, Instant};
 
 /// Every bar fits in this many columns (a standard terminal).
 pub const COLUMNS: usize = 80;
@@ -47,22 +48,143 @@ pub fn dem_bar(hidden: bool, label: &str) -> ProgressBar {
     bar
 }
 
+/// A DEM phase's name, as the bar and the log show it.
+fn phase_name(phase: Phase) -> String {
+    match phase {
+        Phase::Settle => "settle".to_string(),
+        Phase::SpinUp => "spin-up".to_string(),
+        Phase::Period => "record".to_string(),
+        Phase::Reference => "reference".to_string(),
+        Phase::Twin(m) => format!("twin {m}"),
+    }
+}
+
 /// The recorder's progress callback, drawing on `bar` (one length per phase).
 pub fn on_phase(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
     move |phase, done, total| {
-        let name = match phase {
-            Phase::Settle => "settle".to_string(),
-            Phase::SpinUp => "spin-up".to_string(),
-            Phase::Period => "record".to_string(),
-            Phase::Reference => "reference".to_string(),
-            Phase::Twin(m) => format!("twin {m}"),
-        };
+        let name = phase_name(phase);
         if bar.message() != name {
             bar.set_message(name);
             bar.set_length(total);
             bar.reset_eta();
         }
         bar.set_position(done);
+    }
+}
+
+/// Plain progress lines for a run whose stderr is not a terminal (a long recording in the
+/// background, `nohup tdex record … 2> run.log &`), where no bar is drawn: one line when a
+/// DEM phase starts, one at each tenth of its steps and one when it ends, each stamped with
+/// the wall time since the run started, so that `tail -f run.log` shows how far it is, as
+/// LIGGGHTS's thermo output does.
+pub struct PhaseLog<W: std::io::Write> {
+    out: W,
+    started: Instant,
+    /// When the last report came: where the next phase starts.
+    last_report: Instant,
+    /// The phase being logged: when and at which step it started (a resumed run starts
+    /// mid-phase), and the last tenth logged.
+    current: Option<LoggedPhase>,
+}
+
+struct LoggedPhase {
+    phase: Phase,
+    at: Instant,
+    from: u64,
+    tenth: u64,
+}
+
+impl PhaseLog<std::io::Stderr> {
+    /// A log on stderr when it is not a terminal (a terminal has the bar), else `None`.
+    pub fn on_stderr() -> Option<Self> {
+        use std::io::IsTerminal;
+        let err = std::io::stderr();
+        (!err.is_terminal()).then(|| PhaseLog::new(err))
+    }
+}
+
+impl<W: std::io::Write> PhaseLog<W> {
+    pub fn new(out: W) -> Self {
+        let started = Instant::now();
+        PhaseLog {
+            out,
+            started,
+            last_report: started,
+            current: None,
+        }
+    }
+
+    /// A progress report: `done` of `total` steps of `phase`. The recorder reports every
+    /// [`REPORT_EVERY`] steps, so a first report within that many steps is a phase that
+    /// started at the previous report, and a later one a phase that starts mid-way.
+    pub fn report(&mut self, phase: Phase, done: u64, total: u64) {
+        let now = Instant::now();
+        let since = std::mem::replace(&mut self.last_report, now);
+        let stamp = duration(now - self.started);
+        let name = phase_name(phase);
+        let total = total.max(1);
+        let tenth = (done.min(total) * 10 / total).min(9);
+        let line = match &mut self.current {
+            Some(p) if p.phase == phase => {
+                if done >= total {
+                    let took = duration(now - p.at);
+                    self.current = None;
+                    format!("[{stamp}] {name}: done, {} steps in {took}", compact(total))
+                } else if tenth > p.tenth {
+                    p.tenth = tenth;
+                    let rate = (done - p.from) as f64 / (now - p.at).as_secs_f64();
+                    let left = if rate > 0.0 {
+                        let secs = ((total - done) as f64 / rate).min(1e9);
+                        format!(", about {} left", duration(Duration::from_secs_f64(secs)))
+                    } else {
+                        String::new()
+                    };
+                    format!(
+                        "[{stamp}] {name}: {} % ({} of {} steps){left}",
+                        tenth * 10,
+                        compact(done),
+                        compact(total)
+                    )
+                } else {
+                    return;
+                }
+            }
+            // a phase done within its first report (shorter than a report's block)
+            _ if done >= total => format!("[{stamp}] {name}: done, {} steps", compact(total)),
+            _ => {
+                // a resumed run, or twins that part after t1 (`--twins-from`), start mid-phase
+                let resumed = done > REPORT_EVERY;
+                let (at, from) = if resumed { (now, done) } else { (since, 0) };
+                self.current = Some(LoggedPhase {
+                    phase,
+                    at,
+                    from,
+                    tenth: if resumed { tenth } else { 0 },
+                });
+                let from = if resumed {
+                    format!(", from {} %", done * 100 / total)
+                } else {
+                    String::new()
+                };
+                format!("[{stamp}] {name}: {} steps{from}", compact(total))
+            }
+        };
+        // a log that cannot be written is no reason to stop a DEM run: the line is dropped
+        let _ = writeln!(self.out, "{line}");
+        let _ = self.out.flush();
+    }
+}
+
+/// The recorder's progress callback for `tdex record`: the bar, and a [`PhaseLog`] on stderr
+/// when it is not a terminal.
+pub fn on_phase_logged(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
+    let mut draw = on_phase(bar);
+    let mut log = PhaseLog::on_stderr();
+    move |phase, done, total| {
+        draw(phase, done, total);
+        if let Some(log) = &mut log {
+            log.report(phase, done, total);
+        }
     }
 }
 
@@ -141,7 +263,7 @@ fn compact(x: u64) -> String {
 }
 
 /// A duration in at most 8 columns: `45s`, `12m 05s`, `3h 07m`, `2d 05h`.
-fn duration(d: std::time::Duration) -> String {
+fn duration(d: Duration) -> String {
     let s = d.as_secs();
     match s {
         0..=59 => format!("{s}s"),
@@ -168,6 +290,52 @@ fn fit(text: &str, columns: usize) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// One line when a phase starts (or is resumed), one per tenth, one when it ends; a
+    /// new phase starts its own count.
+    #[test]
+    fn the_log_has_a_line_per_tenth_of_each_phase() {
+        let mut out = Vec::new();
+        {
+            let mut log = PhaseLog::new(&mut out);
+            for done in (500..=10_000).step_by(500) {
+                log.report(Phase::SpinUp, done, 10_000);
+            }
+            log.report(Phase::Settle, 300, 300);
+            // a twin resumed at 30 %
+            for done in (300_500..=1_000_000).step_by(500) {
+                log.report(Phase::Twin(2), done, 1_000_000);
+            }
+        }
+        let text = String::from_utf8(out).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let body = |l: &str| l.split_once("] ").unwrap().1.to_string();
+        assert!(lines.iter().all(|l| l.starts_with('[')), "{text}");
+        assert_eq!(body(lines[0]), "spin-up: 10000 steps");
+        assert!(
+            body(lines[1]).starts_with("spin-up: 10 % (1000 of 10000 steps)"),
+            "{text}"
+        );
+        assert!(
+            body(lines[9]).starts_with("spin-up: 90 % (9000 of 10000 steps)"),
+            "{text}"
+        );
+        assert!(
+            body(lines[10]).starts_with("spin-up: done, 10000 steps in "),
+            "{text}"
+        );
+        assert_eq!(body(lines[11]), "settle: done, 300 steps");
+        assert_eq!(body(lines[12]), "twin 2: 1M steps, from 30 %");
+        assert!(
+            body(lines[13]).starts_with("twin 2: 40 % (400k of 1M steps)"),
+            "{text}"
+        );
+        assert!(
+            body(lines[19]).starts_with("twin 2: done, 1M steps in "),
+            "{text}"
+        );
+        assert_eq!(lines.len(), 20, "{text}");
+    }
 
     #[test]
     fn counters_and_durations_are_compact() {

@@ -41,7 +41,7 @@ struct RecordReport {
 
 pub fn run(plan: RecordPlan) -> Result<()> {
     let bar = crate::progress::dem_bar(plan.json, "");
-    let mut progress = crate::progress::on_phase(&bar);
+    let mut progress = crate::progress::on_phase_logged(&bar);
     let (output, case_name) = match plan.start {
         RecordStart::Fresh {
             case_path,

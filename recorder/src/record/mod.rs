@@ -25,7 +25,7 @@ pub use driver::{
 pub use error::RecordError;
 pub use journal::{journal_path, JournalError};
 pub use metadata::{Elapsed, RunAtT0};
-pub use options::{Phase, RecordJob, RecordOptions, RecordRun};
+pub use options::{Phase, RecordJob, RecordOptions, RecordRun, REPORT_EVERY};
 pub use sampler::ContactSampler;
 
 pub use tdex_format::CollisionRow;

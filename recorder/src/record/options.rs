@@ -54,7 +54,7 @@ pub enum Phase {
 
 /// Steps between progress reports, stability checks and checkpoint opportunities outside
 /// the recorded period.
-pub(crate) const REPORT_EVERY: u64 = 500;
+pub const REPORT_EVERY: u64 = 500;
 
 /// A `tdex record` run: what to record, where, and how often to checkpoint it.
 #[derive(Debug, Clone, Copy)]
