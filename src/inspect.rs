@@ -243,8 +243,12 @@ struct ExtrapolatedSnapshot {
 }
 
 /// Summarises a recording, or an extrapolation (a file without recording metadata is
-/// read as one, the way `tdex compare` reads its second file).
+/// read as one, the way `tdex compare` reads its second file), or where a checkpointed
+/// recording stands.
 pub fn run(plan: &InspectPlan) -> Result<()> {
+    if recorder::record::is_checkpoint(&plan.file) {
+        return inspect_checkpoint(plan);
+    }
     match RecordingReader::open(&plan.file) {
         Ok(reader) => inspect_recording(plan, &reader),
         Err(FormatError::NotRecording {
@@ -269,6 +273,114 @@ pub fn run(plan: &InspectPlan) -> Result<()> {
         },
         Err(e) => Err(e.into()),
     }
+}
+
+/// Where a checkpointed `tdex record` stands, and how long it has left at its pace so far.
+#[derive(Debug, Serialize)]
+struct CheckpointInspection {
+    file: String,
+    file_bytes: u64,
+    tool_version: String,
+    case: String,
+    case_path: String,
+    /// The recording the run writes (absolute path).
+    recording: String,
+    recorded_periods: u32,
+    reference_periods: u32,
+    twins: u32,
+    twins_from: u32,
+    /// The checkpoint's own words for where the run stands (its first line).
+    stands_at: String,
+    stage: recorder::record::Stage,
+    steps_done: u64,
+    steps_total: u64,
+    /// Wall-clock seconds the run has taken to this checkpoint (over all its resumptions).
+    wall_seconds: f64,
+    /// `wall_seconds` scaled to the steps left; absent before any step.
+    seconds_left_at_this_pace: Option<f64>,
+    resume: String,
+}
+
+fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
+    use recorder::record::Checkpoint;
+    let checkpoint = Checkpoint::read(&plan.file)?;
+    let case = checkpoint.case(&plan.file)?;
+    let steps = checkpoint.steps(&case);
+    let e = &checkpoint.elapsed;
+    let wall_seconds = e.to_t0 + e.period + e.reference + e.twins;
+    let left = steps.total - steps.done;
+    // the header: "tdex checkpoint vN: <where>; continue with: …"
+    let stands_at = checkpoint
+        .header
+        .split_once(": ")
+        .map_or("", |(_, rest)| rest)
+        .split("; continue with")
+        .next()
+        .unwrap_or("")
+        .to_string();
+    // the case is on its own line
+    let stands_at = stands_at
+        .strip_prefix(&format!("case {}, ", case.name))
+        .map_or(stands_at.clone(), str::to_string);
+    let o = &checkpoint.options;
+    let inspection = CheckpointInspection {
+        file: plan.file.display().to_string(),
+        file_bytes: std::fs::metadata(&plan.file).map_or(0, |m| m.len()),
+        tool_version: checkpoint.tool_version.clone(),
+        case: case.name.clone(),
+        case_path: checkpoint.case_path.display().to_string(),
+        recording: checkpoint.dest.display().to_string(),
+        recorded_periods: o.recorded_periods,
+        reference_periods: o.reference_periods,
+        twins: o.twins,
+        twins_from: o.twins_from,
+        stands_at,
+        stage: checkpoint.stage,
+        steps_done: steps.done,
+        steps_total: steps.total,
+        wall_seconds,
+        seconds_left_at_this_pace: (steps.done > 0)
+            .then(|| wall_seconds * left as f64 / steps.done as f64),
+        resume: format!("tdex record --resume {}", plan.file.display()),
+    };
+    emit(plan.json, &inspection, print_checkpoint)
+}
+
+fn print_checkpoint(c: &CheckpointInspection) {
+    println!(
+        "checkpoint    {} ({:.1} MB, tdex {}): a tdex record run, resumable",
+        c.file,
+        c.file_bytes as f64 / 1e6,
+        c.tool_version
+    );
+    println!("case          {} ({})", c.case, c.case_path);
+    let twins = match c.twins {
+        0 => String::new(),
+        1 => format!(", 1 DEM twin from t{}", c.twins_from),
+        m => format!(", {m} DEM twins from t{}", c.twins_from),
+    };
+    println!(
+        "recording to  {}: {} recorded period{}, {} reference periods{twins}",
+        c.recording,
+        c.recorded_periods,
+        if c.recorded_periods == 1 { "" } else { "s" },
+        c.reference_periods
+    );
+    println!("stands at     {}", c.stands_at);
+    println!(
+        "done          {} of {} steps ({:.1} %) in {} of wall time",
+        c.steps_done,
+        c.steps_total,
+        100.0 * c.steps_done as f64 / c.steps_total.max(1) as f64,
+        crate::progress::duration(std::time::Duration::from_secs_f64(c.wall_seconds.max(0.0)))
+    );
+    if let Some(left) = c.seconds_left_at_this_pace {
+        println!(
+            "left          about {} at the pace so far",
+            crate::progress::duration(std::time::Duration::from_secs_f64(left.clamp(0.0, 1e9)))
+        );
+    }
+    println!("continue with {}", c.resume);
 }
 
 fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()> {

@@ -263,7 +263,7 @@ fn compact(x: u64) -> String {
 }
 
 /// A duration in at most 8 columns: `45s`, `12m 05s`, `3h 07m`, `2d 05h`.
-fn duration(d: Duration) -> String {
+pub fn duration(d: Duration) -> String {
     let s = d.as_secs();
     match s {
         0..=59 => format!("{s}s"),

@@ -401,6 +401,7 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
     let mut args = record_args(&case, &b, &flags);
     args.extend(["--checkpoint-every", "0.02"]);
     let mut stops = vec![kill_at(spawn(&args), &ck, ", recorded period 2 of 2")];
+    let mut stands = vec![inspect_checkpoint(&ck)];
     for stage in [
         ", reference period 2 of 2",
         ", twin 1 of 2 reference period 2",
@@ -409,7 +410,24 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
         assert!(!b.exists(), "a killed run left {}", b.display());
         let resumed = spawn(&["record", "--resume", &ck_arg, "--threads", "1"]);
         stops.push(kill_at(resumed, &ck, stage));
+        stands.push(inspect_checkpoint(&ck));
     }
+    // `tdex inspect` on the checkpoint: settle 2 000 + spin-up 1 000 steps, the run to t3
+    // (3 periods of 6 000 steps), each twin from t2 to t3 (one period)
+    let total = 3000 + 3 * 6000 + 2 * 6000;
+    let done: Vec<u64> = stands
+        .iter()
+        .map(|s| s["steps_done"].as_u64().unwrap())
+        .collect();
+    for s in &stands {
+        assert_eq!(s["steps_total"], total, "{s}");
+        assert_eq!(s["twins_from"], 2, "{s}");
+    }
+    assert!(done.windows(2).all(|w| w[0] < w[1]), "{done:?}");
+    assert!((3000 + 6000..3000 + 12000).contains(&done[0]), "{done:?}");
+    assert!((3000 + 12000..3000 + 18000).contains(&done[1]), "{done:?}");
+    assert!((3000 + 18000..3000 + 24000).contains(&done[2]), "{done:?}");
+    assert!((3000 + 24000..total).contains(&done[3]), "{done:?}");
     resume_to_the_end(&ck_arg, &a, &b, &stops);
     let rec = tdex_format::RecordingReader::open(&a).unwrap();
     assert_eq!(rec.info().twins_from, 2);
@@ -426,4 +444,19 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
         twins[0][1].pos, twins[1][1].pos,
         "the two twins are one run"
     );
+}
+
+/// `tdex inspect --json` on a checkpoint; the human summary is checked to say how to go on.
+fn inspect_checkpoint(ck: &Path) -> serde_json::Value {
+    let ck = ck.to_str().unwrap();
+    let o = run_tdex(&["inspect", ck]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains(&format!("continue with tdex record --resume {ck}")),
+        "{text}"
+    );
+    let o = run_tdex(&["inspect", ck, "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
 }

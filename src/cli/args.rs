@@ -63,7 +63,8 @@ pub enum Command {
     Study(StudyCommand),
     /// Summarise a recording: particles, period, rows, bytes per row, duration histogram,
     /// suggested n, costs. Reads the whole table, so it also checks the file. Given an
-    /// extrapolation: its recording, periods, scheme, pairing and heat balance.
+    /// extrapolation: its recording, periods, scheme, pairing and heat balance. Given a
+    /// checkpoint of `tdex record`: where the run stands and the time left at its pace.
     Inspect(InspectArgs),
 }
 
@@ -296,7 +297,7 @@ pub struct DemoArgs {
 /// `tdex inspect`.
 #[derive(Debug, clap::Args)]
 pub struct InspectArgs {
-    /// The recording or extrapolation (MCAP).
+    /// The recording or extrapolation (MCAP), or a `tdex record` checkpoint.
     pub file: PathBuf,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]

@@ -42,6 +42,24 @@ const HEADER_PREFIX: &str = "tdex checkpoint v";
 /// The header line is at most this long (a reader does not scan a large file for it).
 const MAX_HEADER: usize = 512;
 
+/// Whether `path` starts like a checkpoint (its header's prefix): how `tdex inspect` tells a
+/// checkpoint from a recording before reading either.
+pub fn is_checkpoint(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = [0u8; HEADER_PREFIX.len()];
+    std::fs::File::open(path)
+        .and_then(|mut f| f.read_exact(&mut head))
+        .is_ok_and(|()| head == HEADER_PREFIX.as_bytes())
+}
+
+/// How far a run stands: steps run and steps of the whole job (settling, spin-up, the run's
+/// periods to its last snapshot, each twin's periods from its parting).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct StepsDone {
+    pub done: u64,
+    pub total: u64,
+}
+
 /// Where the checkpoints of a recording to `dest` go: `<dest>.checkpoint`.
 pub fn checkpoint_path(dest: &Path) -> PathBuf {
     let mut name = dest.as_os_str().to_owned();
@@ -186,6 +204,49 @@ impl Checkpoint<'_> {
             file.write_all(&body)
         })?;
         Ok(())
+    }
+}
+
+impl Checkpoint<'_> {
+    /// How far the run stands in `case` (the checkpoint's own, [`Self::case`]).
+    pub fn steps(&self, case: &Case) -> StepsDone {
+        steps_done(
+            &self.options,
+            case.steps_in(case.time.settle),
+            case.steps_in(case.time.spin_up),
+            self.stage,
+        )
+    }
+}
+
+/// [`Checkpoint::steps`] for `opts`, `settle` and `spin_up` steps, at `stage`. The run's
+/// periods reach its last snapshot (`tP` or `t(K+1)`); reference period `p` runs from
+/// `t(p+1)`; a twin runs from its parting `tS` to `t(K+1)`.
+fn steps_done(opts: &RecordOptions, settle: u64, spin_up: u64, stage: Stage) -> StepsDone {
+    let period = opts.period_steps;
+    let to_t0 = settle + spin_up;
+    let run_periods = u64::from(opts.last_snapshot());
+    let twin_periods = u64::from((opts.reference_periods + 1).saturating_sub(opts.twins_from));
+    let twins_at = to_t0 + run_periods * period;
+    let total = twins_at + u64::from(opts.twins) * twin_periods * period;
+    let done = match stage {
+        Stage::Settle { done } => done,
+        Stage::SpinUp { done } => settle + done,
+        Stage::Period { period: p, done } => to_t0 + u64::from(p) * period + done,
+        Stage::Reference { period: p, done } => to_t0 + (u64::from(p) + 1) * period + done,
+        Stage::Twin {
+            twin,
+            period: p,
+            done,
+        } => {
+            // before its parting a twin is the run (period 0: not started)
+            let own = u64::from(p.saturating_sub(opts.twins_from.saturating_sub(1)));
+            twins_at + u64::from(twin - 1) * twin_periods * period + own * period + done
+        }
+    };
+    StepsDone {
+        done: done.min(total),
+        total,
     }
 }
 
@@ -491,4 +552,92 @@ fn apply(
     sim.counters = e.counters.into_owned();
     sim.check_inside().map_err(|e| bad(e.to_string()))?;
     Ok(sim)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn options(recorded: u32, reference: u32, twins: u32, twins_from: u32) -> RecordOptions {
+        RecordOptions {
+            sample_every: 10,
+            dtc_max_steps: 100,
+            period_steps: 1000,
+            reference_periods: reference,
+            twins,
+            recorded_periods: recorded,
+            twins_from,
+            area_encoding: tdex_format::AreaEncoding::Quantized,
+        }
+    }
+
+    /// The steps count every phase once: settle 100 + spin-up 400, two recorded periods,
+    /// the run to t7 (K = 6), and a twin from t2 to t7 (five periods of 1000 steps).
+    #[test]
+    fn a_run_stands_at_the_steps_of_every_phase_before_its_stage() {
+        let opts = options(2, 6, 1, 2);
+        let at = |stage| steps_done(&opts, 100, 400, stage);
+        let total = 500 + 7 * 1000 + 5 * 1000;
+        assert_eq!(
+            at(Stage::Settle { done: 40 }),
+            StepsDone { done: 40, total }
+        );
+        assert_eq!(at(Stage::SpinUp { done: 40 }).done, 140);
+        assert_eq!(
+            at(Stage::Period {
+                period: 1,
+                done: 40
+            })
+            .done,
+            500 + 1040
+        );
+        // the first reference period after two recorded ones runs from t2 (index 1)
+        assert_eq!(
+            at(Stage::Reference {
+                period: 1,
+                done: 40
+            })
+            .done,
+            500 + 2040
+        );
+        assert_eq!(
+            at(Stage::Reference {
+                period: 5,
+                done: 999
+            })
+            .done,
+            500 + 6999
+        );
+        // the twin parts at t2: its period 1 (t2 → t3) is its first own
+        let twin = |period, done| {
+            at(Stage::Twin {
+                twin: 1,
+                period,
+                done,
+            })
+            .done
+        };
+        assert_eq!(twin(0, 0), 7500);
+        assert_eq!(twin(1, 40), 7540);
+        assert_eq!(twin(5, 1000), total);
+        // twins from t1, two of them: each runs six periods
+        let opts = options(1, 6, 2, 1);
+        let second = steps_done(
+            &opts,
+            100,
+            400,
+            Stage::Twin {
+                twin: 2,
+                period: 3,
+                done: 0,
+            },
+        );
+        assert_eq!(second.total, 500 + 7000 + 2 * 6000);
+        assert_eq!(second.done, 500 + 7000 + 6000 + 3000);
+        // no reference: the run ends at tP
+        assert_eq!(
+            steps_done(&options(3, 0, 0, 1), 0, 0, Stage::Settle { done: 0 }).total,
+            3000
+        );
+    }
 }
