@@ -75,8 +75,8 @@ pub fn on_phase(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
 /// Plain progress lines for a run whose stderr is not a terminal (a long recording in the
 /// background, `nohup tdex record … 2> run.log &`), where no bar is drawn: one line when a
 /// DEM phase starts, one at each tenth of its steps and one when it ends, each stamped with
-/// the wall time since the run started, so that `tail -f run.log` shows how far it is, as
-/// LIGGGHTS's thermo output does.
+/// the wall time since this process started (a resumed run counts from its resumption), so
+/// that `tail -f run.log` shows how far it is, as LIGGGHTS's thermo output does.
 pub struct PhaseLog<W: std::io::Write> {
     out: W,
     started: Instant,
