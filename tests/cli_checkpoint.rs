@@ -394,7 +394,20 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
         "2",
     ];
     let o = run_tdex(&record_args(&case, &a, &flags));
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let log = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{log}");
+    // stderr is a pipe here, as in a background run: plain progress lines, each twin's
+    // starting where it parts (t2 of a phase that counts the reference periods from t1)
+    for line in [
+        "] settle: 2000 steps",
+        "] settle: done, 2000 steps in ",
+        "] record: 12000 steps",
+        "] reference: done, 12000 steps in ",
+        "] twin 1: 12000 steps, from 54 %",
+        "] twin 2: done, 12000 steps in ",
+    ] {
+        assert!(log.contains(line), "{line} not in:\n{log}");
+    }
 
     let ck = checkpoint_of(&b);
     let ck_arg = ck.to_str().unwrap().to_string();
