@@ -61,18 +61,33 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     let every = 200;
     let wall_start = Instant::now();
 
+    // a log for a run in the background, where the bar is not drawn
+    let mut log = crate::progress::PhaseLog::on_stderr();
+    let mut logged = |name: &str, done: u64, total: u64| {
+        if let Some(log) = &mut log {
+            log.report(name, done, total);
+        }
+    };
+
     bar.set_message("settle");
-    sim.run(n_settle, every, &mut |s| bar.set_position(s))?;
+    sim.run(n_settle, every, &mut |s| {
+        bar.set_position(s);
+        logged("settle", s, n_settle);
+    })?;
     bar.set_message("spin-up");
     sim.start_rotation();
-    sim.run(n_spin, every, &mut |s| bar.set_position(n_settle + s))?;
+    sim.run(n_spin, every, &mut |s| {
+        bar.set_position(n_settle + s);
+        logged("spin-up", s, n_spin);
+    })?;
 
     sim.assign_temperatures();
     let start = sim.heat_summary();
     bar.set_message("heating");
     let before_heating = sim.counters.clone();
     sim.run(n_heat, every, &mut |s| {
-        bar.set_position(n_settle + n_spin + s)
+        bar.set_position(n_settle + n_spin + s);
+        logged("heating", s, n_heat);
     })?;
     let end = sim.heat_summary();
     bar.finish_and_clear();

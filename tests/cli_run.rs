@@ -44,6 +44,16 @@ fn run_json_reports_the_documented_keys() {
         "stderr: {}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // stderr is a pipe, as in a background run: a progress line per phase and tenth
+    let log = String::from_utf8_lossy(&out.stderr);
+    for line in [
+        "] settle: 2000 steps",
+        "] spin-up: done, 1000 steps in ",
+        "] heating: 50 % (1000 of 2000 steps)",
+        "] heating: done, 2000 steps in ",
+    ] {
+        assert!(log.contains(line), "{line} not in:\n{log}");
+    }
     let v: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
     for key in [
