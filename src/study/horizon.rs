@@ -95,7 +95,7 @@ pub fn run(
                     &plan.case_toml,
                     options,
                     &path,
-                    &mut super::on_phase(&bar),
+                    &mut super::on_phase_logged(&bar),
                 )?)
             })
             .with_context(|| format!("recording {}", plan.case_path.display()))?;

@@ -44,7 +44,7 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
 }
 
 // the DEM phases log plain lines when stderr is not a terminal (a study in the background)
-pub(crate) use crate::progress::{dem_bar, on_phase_logged as on_phase, runs_bar};
+pub(crate) use crate::progress::{dem_bar, on_phase_logged, runs_bar};
 
 /// The errors and costs of one recording extrapolated against its DEM reference.
 #[derive(Debug, Clone, Serialize)]

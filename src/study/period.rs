@@ -46,7 +46,10 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
     let bar = super::dem_bar(plan.json, "study");
     let started = Instant::now();
     let sim0 = crate::with_workers(plan.threads, || {
-        Ok(record::run_to_t0(&plan.case, &mut super::on_phase(&bar))?)
+        Ok(record::run_to_t0(
+            &plan.case,
+            &mut super::on_phase_logged(&bar),
+        )?)
     })
     .with_context(|| format!("running case {} to t0", plan.case_path.display()))?;
     let seconds_to_t0 = started.elapsed().as_secs_f64();
@@ -63,7 +66,7 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
                 o,
                 &rec,
                 seconds_to_t0,
-                &mut super::on_phase(&bar),
+                &mut super::on_phase_logged(&bar),
             )?)
         })
         .with_context(|| format!("recording τ = {f} revolution"))?;

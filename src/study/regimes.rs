@@ -96,7 +96,7 @@ pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64
         }
         let started = Instant::now();
         crate::with_workers(plan.threads, || {
-            let mut progress = super::on_phase(&bar);
+            let mut progress = super::on_phase_logged(&bar);
             let mut sim = record::run_to_t0(&r.case, &mut progress)?;
             let seconds_to_t0 = started.elapsed().as_secs_f64();
             Ok(record::record_from_t0(

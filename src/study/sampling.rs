@@ -78,7 +78,7 @@ pub fn run(
     let bar = super::dem_bar(plan.json, "study");
     let started = Instant::now();
     let seconds_to_t0 = crate::with_workers(plan.threads, || {
-        let mut progress = super::on_phase(&bar);
+        let mut progress = super::on_phase_logged(&bar);
         let mut sim = record::run_to_t0(&plan.case, &mut progress)?;
         let seconds_to_t0 = started.elapsed().as_secs_f64();
         let jobs: Vec<RecordJob> = runs
