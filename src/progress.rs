@@ -105,11 +105,13 @@ impl PhaseLog<std::io::Stderr> {
 
 impl<W: std::io::Write> PhaseLog<W> {
     pub fn new(out: W) -> Self {
-        let started = Instant::now();
+        // one clock for the process: a study makes a log per DEM run, stamped alike
+        static STARTED: std::sync::OnceLock<Instant> = std::sync::OnceLock::new();
+        let started = *STARTED.get_or_init(Instant::now);
         PhaseLog {
             out,
             started,
-            last_report: started,
+            last_report: Instant::now(),
             current: None,
         }
     }
