@@ -9,7 +9,8 @@ usage: fair_start_summary.py DIR BED [BED ...]
        default path and `--seed 1`'s), fBED_b.json (one revolution from t1, `--recorded-periods 1`).
 
 Prints each draw's median ratio over t3…t8, each DEM run's own median judged against the
-other three over the same t_k (compare's verdict.dem_runs_median_ratio), and the means.
+other three over the same t_k (compare's verdict.dem_runs_median_ratio), the means, and how
+often a draw scores above a DEM run in the seat.
 """
 import json
 import statistics as st
@@ -17,6 +18,14 @@ import sys
 
 DRAWS = {"b": "one revolution from t1", "c": "the second revolution repeated",
          "d": "two revolutions, default path", "e": "two revolutions, seed 1's path"}
+
+
+def above(draws, runs):
+    """How often a draw's median exceeds a DEM run's in the seat, over all pairs (ties count
+    half): 0.5 where the draws score like DEM runs. The pairs are not independent (a bed's
+    draws and runs share its DEM), so no p-value is given."""
+    wins = sum((d > r) + 0.5 * (d == r) for d in draws for r in runs)
+    return wins / (len(draws) * len(runs))
 
 
 def main(folder, beds):
@@ -33,7 +42,8 @@ def main(folder, beds):
         print(f"bed {b}: " + ", ".join(line) + "; DEM runs in the seat " + " ".join(f"{x:.2f}" for x in seat))
     for m, name in DRAWS.items():
         xs = draws[m]
-        print(f"{name}: mean {st.mean(xs):.3f}, {min(xs):.2f}–{max(xs):.2f}, {sum(x <= 1 for x in xs)} of {len(xs)} at most 1")
+        print(f"{name}: mean {st.mean(xs):.3f}, {min(xs):.2f}–{max(xs):.2f}, {sum(x <= 1 for x in xs)} of {len(xs)} at most 1, "
+              f"above a DEM run in the seat with probability {above(xs, runs):.2f}")
     print(f"a DEM run in the seat: mean {st.mean(runs):.3f}, median {st.median(runs):.3f}, "
           f"{min(runs):.2f}–{max(runs):.2f}, {sum(x <= 1 for x in runs)} of {len(runs)} at most 1")
 
