@@ -6,7 +6,9 @@ usage: fair_start_summary.py DIR BED [BED ...]
        DIR holds, for every BED (a seed), `tdex compare --json` outputs of the recording fBED.mcap
        (`--recorded-periods 2 --reference 7 --twins 3 --twins-from 2`): fBED_c.json (the second
        revolution repeated, `--jump-to 2`), fBED_d.json and fBED_e.json (two revolutions, the
-       default path and `--seed 1`'s), fBED_b.json (one revolution from t1, `--recorded-periods 1`).
+       default path and `--seed 1`'s), fBED_b.json (one revolution from t1, `--recorded-periods 1`);
+       and where present oBED_x.json: the paper's method, `tdex compare oBED.mcap` of a recording
+       `--reference 7 --twins 3` (twins from t1) and its extrapolation over 7 periods.
 
 Prints each draw's median ratio over t3…t8, each DEM run's own median judged against the
 other three over the same t_k (compare's verdict.dem_runs_median_ratio), the means, and how
@@ -46,6 +48,27 @@ def main(folder, beds):
               f"above a DEM run in the seat with probability {above(xs, runs):.2f}")
     print(f"a DEM run in the seat: mean {st.mean(runs):.3f}, median {st.median(runs):.3f}, "
           f"{min(runs):.2f}–{max(runs):.2f}, {sum(x <= 1 for x in runs)} of {len(runs)} at most 1")
+    paper_method(folder, beds)
+
+
+def paper_method(folder, beds):
+    """The paper's method on the same beds where recorded: oBED.mcap (`--reference 7 --twins 3`,
+    twins from t1) extrapolated over 7 periods from t1 (oBED_x.json), medians over t2…t8."""
+    draws, runs = [], []
+    for b in beds:
+        try:
+            v = json.load(open(f"{folder}/o{b}_x.json"))["verdict"]
+        except FileNotFoundError:
+            continue
+        draws.append(v["median_ratio"])
+        runs += v["dem_runs_median_ratio"]
+        print(f"bed {b}, one revolution from t1, twins from t1: {v['median_ratio']:.2f}; DEM runs in the seat "
+              + " ".join(f"{x:.2f}" for x in v["dem_runs_median_ratio"]))
+    if draws:
+        print(f"one revolution from t1 (the paper's method, twins from t1): mean {st.mean(draws):.3f}, "
+              f"{min(draws):.2f}–{max(draws):.2f}, {sum(x <= 1 for x in draws)} of {len(draws)} at most 1, "
+              f"above a DEM run in the seat with probability {above(draws, runs):.2f}; the runs in the seat: "
+              f"mean {st.mean(runs):.3f}, median {st.median(runs):.3f}, {sum(x <= 1 for x in runs)} of {len(runs)} at most 1")
 
 
 if __name__ == "__main__":
