@@ -309,19 +309,7 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
     let e = &checkpoint.elapsed;
     let wall_seconds = e.to_t0 + e.period + e.reference + e.twins;
     let left = steps.total - steps.done;
-    // the header: "tdex checkpoint vN: <where>; continue with: …"
-    let stands_at = checkpoint
-        .header
-        .split_once(": ")
-        .map_or("", |(_, rest)| rest)
-        .split("; continue with")
-        .next()
-        .unwrap_or("")
-        .to_string();
-    // the case is on its own line
-    let stands_at = stands_at
-        .strip_prefix(&format!("case {}, ", case.name))
-        .map_or(stands_at.clone(), str::to_string);
+    let stands_at = checkpoint.stands_at(&case);
     let o = &checkpoint.options;
     let inspection = CheckpointInspection {
         file: plan.file.display().to_string(),
@@ -346,6 +334,15 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
     emit(plan.json, &inspection, print_checkpoint)
 }
 
+/// `, 2 DEM twins from t1` (empty without twins), after the reference periods.
+fn twins_phrase(twins: u32, twins_from: u32) -> String {
+    match twins {
+        0 => String::new(),
+        1 => format!(", 1 DEM twin from t{twins_from}"),
+        m => format!(", {m} DEM twins from t{twins_from}"),
+    }
+}
+
 fn print_checkpoint(c: &CheckpointInspection) {
     println!(
         "checkpoint    {} ({:.1} MB, tdex {}): a tdex record run, resumable",
@@ -354,11 +351,7 @@ fn print_checkpoint(c: &CheckpointInspection) {
         c.tool_version
     );
     println!("case          {} ({})", c.case, c.case_path);
-    let twins = match c.twins {
-        0 => String::new(),
-        1 => format!(", 1 DEM twin from t{}", c.twins_from),
-        m => format!(", {m} DEM twins from t{}", c.twins_from),
-    };
+    let twins = twins_phrase(c.twins, c.twins_from);
     println!(
         "recording to  {}: {} recorded period{}, {} reference periods{twins}",
         c.recording,
@@ -494,11 +487,7 @@ fn print_human(s: &Inspection) {
         &format!(
             "{} reference periods{}",
             s.sampling.reference_periods,
-            match s.sampling.twins {
-                0 => String::new(),
-                1 => format!(", 1 DEM twin from t{}", s.sampling.twins_from),
-                m => format!(", {m} DEM twins from t{}", s.sampling.twins_from),
-            }
+            twins_phrase(s.sampling.twins, s.sampling.twins_from)
         ),
     );
     println!(

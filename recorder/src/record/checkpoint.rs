@@ -208,6 +208,16 @@ impl Checkpoint<'_> {
 }
 
 impl Checkpoint<'_> {
+    /// Where the run stands in `case` (the checkpoint's own, [`Self::case`]), in the words of
+    /// its first line: `spin-up step 36500 of 50000, t = 4.650000 s`.
+    pub fn stands_at(&self, case: &Case) -> String {
+        format!(
+            "{}, t = {:.6} s",
+            super::saver::describe(self.stage, case, &self.options),
+            self.engine.time
+        )
+    }
+
     /// How far the run stands in `case` (the checkpoint's own, [`Self::case`]).
     pub fn steps(&self, case: &Case) -> StepsDone {
         steps_done(

@@ -5,7 +5,8 @@ use super::checkpoint::{Checkpoint, CheckpointError, EngineState, OutputState, S
 use super::error::RecordError;
 use super::journal::journal_path;
 use super::metadata::Elapsed;
-use super::options::RecordRun;
+use super::options::{RecordOptions, RecordRun};
+use crate::case::Case;
 use crate::Simulation;
 use std::borrow::Cow;
 use std::path::{Path, PathBuf};
@@ -91,7 +92,7 @@ impl<'a> Saver<'a> {
         let header = format!(
             "case {}, {}, t = {:.6} s; continue with: tdex record --resume {}",
             run.case.name,
-            describe(stage, run),
+            describe(stage, run.case, run.options),
             sim.time,
             self.path.display()
         );
@@ -107,10 +108,8 @@ impl<'a> Saver<'a> {
     }
 }
 
-/// Where a run stands, in words (the checkpoint's first line).
-fn describe(stage: Stage, run: &RecordRun) -> String {
-    let c = run.case;
-    let o = run.options;
+/// Where a run stands, in words (the checkpoint's first line, and `tdex inspect`'s).
+pub(super) fn describe(stage: Stage, c: &Case, o: &RecordOptions) -> String {
     match stage {
         Stage::Settle { done } => format!("settle step {done} of {}", c.steps_in(c.time.settle)),
         Stage::SpinUp { done } => format!("spin-up step {done} of {}", c.steps_in(c.time.spin_up)),
