@@ -15,7 +15,7 @@ pub struct Floor {
     pub floor_eps_abs_max: f64,
     /// Pairs of DEM runs measured.
     pub floor_pairs: usize,
-    /// The extrapolation's mean `ε_abs` (K) to the DEM runs (see [`Against`]).
+    /// The extrapolation's mean `ε_abs` (K) to the DEM runs (see [`Departure`]).
     pub eps_abs_to_dem_runs: f64,
     /// `eps_abs_to_dem_runs / floor_eps_abs`; absent when the DEM runs are identical
     /// (floor 0): nothing to judge against, not an infinite ratio.
@@ -40,72 +40,57 @@ pub struct Field<'a> {
     pub temp: &'a [f64],
 }
 
-/// Which DEM runs the second field's distance is measured to: those that parted from its
-/// past as early as they parted from each other.
+/// Where the second field left the reference, against where the twins parted from it: which
+/// DEM runs its distance is measured to, and whether their spread is a fair floor for it. One
+/// answer to both, so that the distance and the verdict's caveat cannot disagree.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Against {
-    /// All of them: an extrapolation that leaves the reference at `t1`, where the twins do,
-    /// or a second DEM run.
-    AllRuns,
-    /// All but the reference (the first run): an extrapolation of several recorded periods
-    /// is the reference itself until its first jump, so its distance to the reference has
-    /// had less time to grow than the runs' distances to each other, which would flatter it.
-    /// The twins parted from that shared past earlier (`t1` unless recorded with
-    /// `--twins-from`), as from each other.
-    AllButTheReference,
+pub enum Departure {
+    /// Where the twins part (the paper's method, twins from the extrapolation's start), or a
+    /// second DEM run: one more run, measured to all of them.
+    WithTheTwins,
+    /// After the twins parted: an extrapolation of several recorded periods is the reference
+    /// itself until its first jump `t_left`, so its distance to the reference has had less
+    /// time to grow than the runs' distances to each other, which would flatter it. It is
+    /// measured to all runs but the reference; the twins parted from that shared past at
+    /// `t_parted`, as from each other.
+    AfterTheTwins { left: u32, parted: u32 },
+    /// Before the twins parted at `t_parted` (`--twins-from` later than its start `t_left`):
+    /// measured to all runs, but the twins followed the reference past its start, so their
+    /// distances have had less time to grow than its own and their floor is narrower than a
+    /// fair one for it.
+    BeforeTheTwins { left: u32, parted: u32 },
 }
 
-impl Against {
-    /// For an extrapolation that is the reference until `t_recorded_until` (its first jump;
-    /// 1 for the paper's method) of a recording whose twins part at `t_twins_from`: all runs
-    /// when it leaves the reference no later than the twins do, else all but the reference.
-    pub fn for_extrapolation(recorded_until: u32, twins_from: u32) -> Against {
+impl Departure {
+    /// For a second field that is the reference until `t_recorded_until` (its first jump; 1
+    /// for the paper's method, `u32::MAX` for a path that never jumps, 0 for a DEM run) of a
+    /// recording whose twins part at `t_twins_from`.
+    pub fn of(recorded_until: u32, twins_from: u32) -> Departure {
+        let (left, parted) = (recorded_until, twins_from);
         if recorded_until >= 2 && recorded_until > twins_from {
-            Against::AllButTheReference
+            Departure::AfterTheTwins { left, parted }
+        } else if (1..twins_from).contains(&recorded_until) {
+            Departure::BeforeTheTwins { left, parted }
         } else {
-            Against::AllRuns
+            Departure::WithTheTwins
         }
     }
-}
 
-/// Where the twins parted from the reference, against where the second field left it: whether
-/// their spread is a fair floor for it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Parting {
-    /// No later than the second field left the reference (or it is a DEM run): the twins
-    /// have been apart as long as it has.
-    NoLater,
-    /// At `t_parted`, after the extrapolation left the reference at `t_left`
-    /// (`--twins-from` later than its start): the twins followed the reference past the
-    /// extrapolation's start, so their distances to it have had less time to grow than the
-    /// extrapolation's, and their floor is narrower than a fair one for it.
-    After { left: u32, parted: u32 },
-}
-
-impl Parting {
-    /// For an extrapolation that is the reference until `t_recorded_until` (0 for a DEM run)
-    /// of a recording whose twins part at `t_twins_from`.
-    pub fn of(recorded_until: u32, twins_from: u32) -> Parting {
-        if (1..twins_from).contains(&recorded_until) {
-            Parting::After {
-                left: recorded_until,
-                parted: twins_from,
-            }
-        } else {
-            Parting::NoLater
-        }
+    /// Whether the reference (the first run) is left out of the runs its distance goes to.
+    fn skips_the_reference(self) -> bool {
+        matches!(self, Departure::AfterTheTwins { .. })
     }
 }
 
 /// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
-/// the distance of `second` (cell means already computed) to those `against` names, on
+/// the distance of `second` (cell means already computed) to those its `departure` names, on
 /// `cells`. `None` with fewer than two runs or when no cell holds particles of both fields
 /// of some pair.
 pub fn floor(
     cells: &Cells,
     runs: &[Field],
     second: &[Option<f64>],
-    against: Against,
+    departure: Departure,
 ) -> Option<Floor> {
     if runs.len() < 2 {
         return None;
@@ -123,10 +108,7 @@ pub fn floor(
             pairs.push(d);
         }
     }
-    let skip = match against {
-        Against::AllRuns => 0,
-        Against::AllButTheReference => 1,
-    };
+    let skip = usize::from(departure.skips_the_reference());
     let to_runs = means[skip..]
         .iter()
         .map(|m| eps_abs(m, second).map(|(e, _)| e))
@@ -179,29 +161,31 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_reference_is_left_out_only_when_the_extrapolation_follows_it_past_the_twins_parting() {
-        // the paper's method, and twins that part where the extrapolation starts
-        use Against::{AllButTheReference, AllRuns};
-        assert_eq!(Against::for_extrapolation(1, 1), AllRuns);
-        assert_eq!(Against::for_extrapolation(2, 2), AllRuns);
-        assert_eq!(Against::for_extrapolation(3, 3), AllRuns);
-        // an extrapolation that starts before the twins part (its verdict says so)
-        assert_eq!(Against::for_extrapolation(1, 2), AllRuns);
-        // several recorded periods, twins from t1 or from a snapshot before the start
-        assert_eq!(Against::for_extrapolation(2, 1), AllButTheReference);
-        assert_eq!(Against::for_extrapolation(3, 2), AllButTheReference);
-        // a path that never jumps (u32::MAX) stays the reference throughout
-        assert_eq!(Against::for_extrapolation(u32::MAX, 4), AllButTheReference);
-    }
-
-    #[test]
-    fn the_twins_part_late_only_after_an_extrapolation_left_the_reference() {
-        assert_eq!(Parting::of(1, 2), Parting::After { left: 1, parted: 2 });
-        assert_eq!(Parting::of(2, 3), Parting::After { left: 2, parted: 3 });
-        for (recorded_until, twins_from) in [(1, 1), (2, 2), (3, 2), (u32::MAX, 4), (0, 3)] {
-            // 0: a second DEM run, which never was the reference
-            assert_eq!(Parting::of(recorded_until, twins_from), Parting::NoLater);
+    fn the_departure_names_the_runs_measured_to_and_a_late_parting() {
+        use Departure::{AfterTheTwins, BeforeTheTwins, WithTheTwins};
+        // the paper's method, twins that part where the extrapolation starts, a DEM run
+        for (recorded_until, twins_from) in [(1, 1), (2, 2), (3, 3), (0, 1), (0, 3)] {
+            assert_eq!(Departure::of(recorded_until, twins_from), WithTheTwins);
         }
+        // several recorded periods, twins from t1 or from a snapshot before the start; a
+        // path that never jumps (u32::MAX) stays the reference throughout
+        assert_eq!(Departure::of(2, 1), AfterTheTwins { left: 2, parted: 1 });
+        assert_eq!(Departure::of(3, 2), AfterTheTwins { left: 3, parted: 2 });
+        let never = Departure::of(u32::MAX, 4);
+        assert_eq!(
+            never,
+            AfterTheTwins {
+                left: u32::MAX,
+                parted: 4
+            }
+        );
+        // an extrapolation that starts before the twins part (its verdict says so)
+        assert_eq!(Departure::of(1, 2), BeforeTheTwins { left: 1, parted: 2 });
+        assert_eq!(Departure::of(2, 3), BeforeTheTwins { left: 2, parted: 3 });
+        // the reference is left out only for one that followed it past the twins' parting
+        assert!(never.skips_the_reference());
+        assert!(!WithTheTwins.skips_the_reference());
+        assert!(!Departure::of(1, 2).skips_the_reference());
     }
 
     fn cells() -> Cells {
@@ -227,7 +211,7 @@ mod tests {
             temp: &temp,
         };
         let extra = [Some(16.0), Some(35.0)];
-        let f = floor(&cells(), &[dem, twin], &extra, Against::AllRuns).unwrap();
+        let f = floor(&cells(), &[dem, twin], &extra, Departure::WithTheTwins).unwrap();
         assert_eq!(f.floor_eps_abs, 0.0);
         assert_eq!(f.floor_eps_abs_max, 0.0);
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
@@ -251,14 +235,26 @@ mod tests {
             },
         ];
         // the extrapolation halfway between them: 0.5 K from each
-        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)], Against::AllRuns).unwrap();
+        let f = floor(
+            &cells(),
+            &runs,
+            &[Some(16.0), Some(35.0)],
+            Departure::WithTheTwins,
+        )
+        .unwrap();
         assert_eq!(f.floor_eps_abs, 1.0);
         assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         assert_eq!(f.ratio_to_floor, Some(0.5));
         assert!(within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
         // a field 3 K off in the first cell is farther than the runs are from each other
-        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)], Against::AllRuns).unwrap();
+        let far = floor(
+            &cells(),
+            &runs,
+            &[Some(19.0), Some(35.0)],
+            Departure::WithTheTwins,
+        )
+        .unwrap();
         assert_eq!(far.eps_abs_to_dem_runs, 1.5);
         assert_eq!(far.ratio_to_floor, Some(1.5));
         assert!(!within(far.eps_abs_to_dem_runs, far.floor_eps_abs_max));
@@ -268,16 +264,16 @@ mod tests {
                 &cells(),
                 &runs[..1],
                 &[Some(15.0), Some(35.0)],
-                Against::AllRuns
+                Departure::WithTheTwins
             ),
             None
         );
         // the field of the DEM itself (an extrapolation still on the reference): half the
         // floor to both runs, the whole floor to the twin alone
         let on_dem = [Some(15.0), Some(35.0)];
-        let all = floor(&cells(), &runs, &on_dem, Against::AllRuns).unwrap();
+        let all = floor(&cells(), &runs, &on_dem, Departure::WithTheTwins).unwrap();
         assert_eq!(all.ratio_to_floor, Some(0.5));
-        let twins = floor(&cells(), &runs, &on_dem, Against::AllButTheReference).unwrap();
+        let twins = floor(&cells(), &runs, &on_dem, Departure::of(2, 1)).unwrap();
         assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
         assert_eq!(twins.ratio_to_floor, Some(1.0));
         assert_eq!(twins.floor_eps_abs, all.floor_eps_abs);
@@ -294,7 +290,7 @@ mod tests {
         ];
         let runs: Vec<Field> = temps.iter().map(|t| Field { pos: &POS, temp: t }).collect();
         let on_first = [Some(15.0), Some(35.0)];
-        let f = floor(&cells(), &runs, &on_first, Against::AllRuns).unwrap();
+        let f = floor(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
         // run 0: to the others (1 + 5) / 2 = 3, their distance 4; run 1: (1 + 4) / 2 over 5;
         // run 2: (5 + 4) / 2 over 1
         assert_eq!(
@@ -305,12 +301,12 @@ mod tests {
         assert_eq!(f.floor_eps_abs, 10.0 / 3.0);
         assert_eq!(f.eps_abs_to_dem_runs, 2.0);
         // two runs: neither has a floor of others to be judged against
-        let two = floor(&cells(), &runs[..2], &on_first, Against::AllRuns).unwrap();
+        let two = floor(&cells(), &runs[..2], &on_first, Departure::WithTheTwins).unwrap();
         assert!(two.runs_ratio_to_others.is_empty());
         // identical others give no ratio, not an infinite one
         let same = [temps[0], temps[0], temps[1]];
         let runs: Vec<Field> = same.iter().map(|t| Field { pos: &POS, temp: t }).collect();
-        let f = floor(&cells(), &runs, &on_first, Against::AllRuns).unwrap();
+        let f = floor(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
         assert_eq!(f.runs_ratio_to_others[2], None);
         assert_eq!(f.runs_ratio_to_others[0], Some(0.5));
     }

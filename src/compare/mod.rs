@@ -98,7 +98,7 @@ pub struct PeriodComparison {
     /// `ε_abs` between two DEM runs, the mean relative to `contrast`, the second field's mean
     /// `ε_abs` to the DEM runs and its ratio to the mean floor (null when the floor is 0).
     /// An extrapolation of several recorded periods, the reference itself until its first
-    /// jump, is measured to the other runs only ([`floor::Against`]).
+    /// jump, is measured to the other runs only ([`floor::Departure`]).
     pub floor_eps_abs: Option<f64>,
     pub floor_eps_abs_min: Option<f64>,
     pub floor_eps_abs_max: Option<f64>,
@@ -398,9 +398,9 @@ pub fn compare_runs(
     // An extrapolation that follows the reference past the twins' parting t_s (several
     // recorded periods, twins from t1) is measured against the runs that parted from that
     // shared past at t_s: the twins and any further runs, not the reference
-    // (floor::Against). One that leaves the reference where the twins do is one more run.
-    let twins_from = recording.info().twins_from;
-    let against = floor::Against::for_extrapolation(recorded_until, twins_from);
+    // (floor::Departure). One that leaves the reference where the twins do is one more run;
+    // one that leaves it before they part is measured to all, its verdict saying so.
+    let departure = floor::Departure::of(recorded_until, recording.info().twins_from);
 
     // The extrapolated positions are the roles' positions at the end of the recorded period
     // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
@@ -477,7 +477,7 @@ pub fn compare_runs(
                 temp: &s.temp,
             })
             .collect();
-        let floor = floor::floor(&cells_v, &runs, &extra_means, against);
+        let floor = floor::floor(&cells_v, &runs, &extra_means, departure);
         // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
         // has no snapshot at t1, where it is the reference
         let floor_energy_error = others
@@ -551,12 +551,7 @@ pub fn compare_runs(
     }
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
-    let verdict = Verdict::of(
-        &periods,
-        1 + others.len(),
-        floor::Parting::of(recorded_until, twins_from),
-        contrast_kind,
-    );
+    let verdict = Verdict::of(&periods, 1 + others.len(), departure, contrast_kind);
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,

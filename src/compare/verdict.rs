@@ -2,7 +2,7 @@
 //! pass as one more DEM run of the case (median ratio to their spread ≤ 1 and, with three
 //! or more DEM runs, within their own range at every compared `t_k`)?
 
-use super::floor::{median, Parting};
+use super::floor::{median, Departure};
 use super::{ContrastKind, PeriodComparison};
 use serde::Serialize;
 
@@ -130,12 +130,12 @@ impl Verdict {
     /// 1 are named. The `t_k` where the extrapolation was still the recorded run
     /// ([`PeriodComparison::within_recording`]) are left out: there it is the DEM itself.
     /// Where the twins parted from the reference after the extrapolation left it
-    /// ([`Parting::After`]), the judgement stands but says its floor is narrower than a fair
+    /// ([`Departure::BeforeTheTwins`]), the judgement stands but says its floor is narrower than a fair
     /// one.
     pub fn of(
         periods: &[PeriodComparison],
         dem_runs: usize,
-        parting: Parting,
+        departure: Departure,
         contrast: ContrastKind,
     ) -> Self {
         let within_recording: Vec<u32> = periods
@@ -234,12 +234,16 @@ impl Verdict {
                 instants(&within_recording, within_recording.len())
             )
         };
-        let late_parting = match parting {
-            Parting::After { left, parted } if dem_runs > 1 && median_ratio.is_some() => format!(
+        let late_parting = match departure {
+            Departure::BeforeTheTwins { left, parted }
+                if dem_runs > 1 && median_ratio.is_some() =>
+            {
+                format!(
                 "; the twins parted from the DEM at t{parted}, after the extrapolation left it \
                  (t{left}): their spread from t{} on is narrower than a fair floor for it",
                 parted + 1
-            ),
+            )
+            }
             _ => String::new(),
         };
         let text = match (passes, median_ratio) {
@@ -396,7 +400,12 @@ mod tests {
             .zip(ratios)
             .map(|(k, &r)| period(k, r, spread))
             .collect();
-        Verdict::of(&periods, dem_runs, Parting::NoLater, ContrastKind::HotCold)
+        Verdict::of(
+            &periods,
+            dem_runs,
+            Departure::WithTheTwins,
+            ContrastKind::HotCold,
+        )
     }
 
     /// With one twin the range is the one pair's distance, so a ratio above 1 at some t_k
@@ -438,14 +447,19 @@ mod tests {
             .map(|(&r, k)| period(k, r, 1.0))
             .collect();
         periods[0].within_recording = true;
-        let v = Verdict::of(&periods, 2, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 2, Departure::WithTheTwins, ContrastKind::HotCold);
         assert_eq!(v.within_recording, vec![2]);
         assert_eq!(v.compared, vec![3, 4, 5]);
         assert_eq!(v.median_ratio, Some(1.02));
         assert_eq!(v.passes, Some(false), "{}", v.text);
         assert!(v.text.contains("over t3…t5"), "{}", v.text);
         assert!(v.text.contains("t2 left out"), "{}", v.text);
-        let v = Verdict::of(&periods[..1], 2, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(
+            &periods[..1],
+            2,
+            Departure::WithTheTwins,
+            ContrastKind::HotCold,
+        );
         assert_eq!(v.passes, None);
         assert!(
             v.text.starts_with("not judged: at every compared t_k (t2)"),
@@ -483,7 +497,7 @@ mod tests {
         for (p, straggler) in periods.iter_mut().zip([1.2, 1.4, 1.3, 1.3, 1.5, 1.1]) {
             p.dem_runs_ratio_to_others = vec![Some(0.8), Some(0.9), Some(1.0), Some(straggler)];
         }
-        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio, vec![0.8, 0.9, 1.0, 1.3]);
         assert!(
             v.text
@@ -494,11 +508,11 @@ mod tests {
         // the recorded stretch is left out of the runs' medians as of the extrapolation's
         periods[0].within_recording = true;
         periods[0].dem_runs_ratio_to_others[3] = Some(9.0);
-        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio[3], 1.3);
         // a run missing at one compared t_k: no medians, and nothing said
         periods[2].dem_runs_ratio_to_others.pop();
-        let v = Verdict::of(&periods, 4, Parting::NoLater, ContrastKind::HotCold);
+        let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert!(v.dem_runs_median_ratio.is_empty());
         assert!(!v.text.contains("each DEM run"), "{}", v.text);
     }
@@ -512,8 +526,8 @@ mod tests {
             .zip(2..)
             .map(|(&r, k)| period(k, r, 1.0))
             .collect();
-        let late = Parting::After { left: 1, parted: 2 };
-        let fair = Verdict::of(&periods, 2, Parting::NoLater, ContrastKind::HotCold);
+        let late = Departure::BeforeTheTwins { left: 1, parted: 2 };
+        let fair = Verdict::of(&periods, 2, Departure::WithTheTwins, ContrastKind::HotCold);
         let v = Verdict::of(&periods, 2, late, ContrastKind::HotCold);
         assert_eq!(v.passes, fair.passes);
         assert_eq!(v.median_ratio, fair.median_ratio);
