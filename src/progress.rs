@@ -2,7 +2,7 @@
 //! command that runs the DEM.
 
 use indicatif::{ProgressBar, ProgressState, ProgressStyle};
-use recorder::record::{Phase, REPORT_EVERY};
+use recorder::record::Phase;
 use std::time::{Duration, Instant};
 
 /// Every bar fits in this many columns (a standard terminal).
@@ -80,8 +80,6 @@ pub fn on_phase(bar: &ProgressBar) -> impl FnMut(Phase, u64, u64) + '_ {
 pub struct PhaseLog<W: std::io::Write> {
     out: W,
     started: Instant,
-    /// When the last report came: where the next phase starts.
-    last_report: Instant,
     /// The phase being logged: when and at which step it started (a resumed run starts
     /// mid-phase), and the last tenth logged.
     current: Option<LoggedPhase>,
@@ -111,17 +109,16 @@ impl<W: std::io::Write> PhaseLog<W> {
         PhaseLog {
             out,
             started,
-            last_report: Instant::now(),
             current: None,
         }
     }
 
-    /// A progress report: `done` of `total` steps of the phase `name`. The recorder reports every
-    /// [`REPORT_EVERY`] steps, so a first report within that many steps is a phase that
-    /// started at the previous report, and a later one a phase that starts mid-way.
+    /// A progress report: `done` of `total` steps of the phase `name`. The caller reports a
+    /// phase once where it starts, before its first step (0, or mid-way: a resumed run,
+    /// twins that part after t1), as the recorder does ([`Phase`]); that first report starts
+    /// the phase's clock.
     pub fn report(&mut self, name: &str, done: u64, total: u64) {
         let now = Instant::now();
-        let since = std::mem::replace(&mut self.last_report, now);
         let stamp = duration(now - self.started);
         let total = total.max(1);
         let tenth = (done.min(total) * 10 / total).min(9);
@@ -150,19 +147,17 @@ impl<W: std::io::Write> PhaseLog<W> {
                     return;
                 }
             }
-            // a phase done within its first report (shorter than a report's block)
+            // a phase with no steps left
             _ if done >= total => format!("[{stamp}] {name}: done, {} steps", compact(total)),
             _ => {
-                // a resumed run, or twins that part after t1 (`--twins-from`), start mid-phase
-                let resumed = done > REPORT_EVERY;
-                let (at, from) = if resumed { (now, done) } else { (since, 0) };
                 self.current = Some(LoggedPhase {
                     name: name.to_string(),
-                    at,
-                    from,
-                    tenth: if resumed { tenth } else { 0 },
+                    at: now,
+                    from: done,
+                    tenth,
                 });
-                let from = if resumed {
+                // a resumed run, or twins that part after t1 (`--twins-from`), start mid-phase
+                let from = if done > 0 {
                     format!(", from {} %", done * 100 / total)
                 } else {
                     String::new()
@@ -299,12 +294,13 @@ mod tests {
         let mut out = Vec::new();
         {
             let mut log = PhaseLog::new(&mut out);
-            for done in (500..=10_000).step_by(500) {
+            for done in (0..=10_000).step_by(500) {
                 log.report("spin-up", done, 10_000);
             }
+            log.report("settle", 0, 300);
             log.report("settle", 300, 300);
             // a twin resumed at 30 %
-            for done in (300_500..=1_000_000).step_by(500) {
+            for done in (300_000..=1_000_000).step_by(500) {
                 log.report("twin 2", done, 1_000_000);
             }
         }
@@ -325,17 +321,27 @@ mod tests {
             body(lines[10]).starts_with("spin-up: done, 10000 steps in "),
             "{text}"
         );
-        assert_eq!(body(lines[11]), "settle: done, 300 steps");
-        assert_eq!(body(lines[12]), "twin 2: 1M steps, from 30 %");
+        // a phase shorter than a report's block: its start and its end
+        assert_eq!(body(lines[11]), "settle: 300 steps");
         assert!(
-            body(lines[13]).starts_with("twin 2: 40 % (400k of 1M steps)"),
+            body(lines[12]).starts_with("settle: done, 300 steps in "),
+            "{text}"
+        );
+        assert_eq!(body(lines[13]), "twin 2: 1M steps, from 30 %");
+        assert!(
+            body(lines[14]).starts_with("twin 2: 40 % (400k of 1M steps)"),
             "{text}"
         );
         assert!(
-            body(lines[19]).starts_with("twin 2: done, 1M steps in "),
+            body(lines[20]).starts_with("twin 2: done, 1M steps in "),
             "{text}"
         );
-        assert_eq!(lines.len(), 20, "{text}");
+        assert_eq!(lines.len(), 21, "{text}");
+        // a phase with nothing left to run (resumed at its end) is one line
+        let mut out = Vec::new();
+        PhaseLog::new(&mut out).report("reference", 250_000, 250_000);
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(body(text.trim_end()), "reference: done, 250k steps");
     }
 
     #[test]

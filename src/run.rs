@@ -61,7 +61,8 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     let every = 200;
     let wall_start = Instant::now();
 
-    // a log for a run in the background, where the bar is not drawn
+    // a log for a run in the background, where the bar is not drawn; each phase is reported
+    // once before its first step (PhaseLog::report)
     let mut log = crate::progress::PhaseLog::on_stderr();
     let mut logged = |name: &str, done: u64, total: u64| {
         if let Some(log) = &mut log {
@@ -70,12 +71,14 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     };
 
     bar.set_message("settle");
+    logged("settle", 0, n_settle);
     sim.run(n_settle, every, &mut |s| {
         bar.set_position(s);
         logged("settle", s, n_settle);
     })?;
     bar.set_message("spin-up");
     sim.start_rotation();
+    logged("spin-up", 0, n_spin);
     sim.run(n_spin, every, &mut |s| {
         bar.set_position(n_settle + s);
         logged("spin-up", s, n_spin);
@@ -85,6 +88,7 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     let start = sim.heat_summary();
     bar.set_message("heating");
     let before_heating = sim.counters.clone();
+    logged("heating", 0, n_heat);
     sim.run(n_heat, every, &mut |s| {
         bar.set_position(n_settle + n_spin + s);
         logged("heating", s, n_heat);

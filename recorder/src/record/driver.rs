@@ -308,7 +308,8 @@ fn advance_to_t0(
 
 /// Runs `total - done` more steps of a phase in blocks of [`REPORT_EVERY`] (counted from
 /// the phase's start), checking stability and reporting after each block and offering a
-/// checkpoint between blocks.
+/// checkpoint between blocks. It reports once before its first step too, where it starts
+/// (0, or mid-way after a resume), so that a progress log knows a phase's start exactly.
 fn run_phase(
     sim: &mut Simulation,
     mut done: u64,
@@ -316,6 +317,9 @@ fn run_phase(
     progress: &mut dyn FnMut(u64),
     checkpoint: &mut dyn FnMut(&Simulation, u64) -> Result<(), RecordError>,
 ) -> Result<(), RecordError> {
+    if done < total {
+        progress(done);
+    }
     while done < total {
         let block = (REPORT_EVERY - done % REPORT_EVERY).min(total - done);
         for _ in 0..block {

@@ -41,7 +41,9 @@ impl RecordOptions {
     }
 }
 
-/// The stage a progress report belongs to.
+/// The stage a progress report belongs to. A report `(phase, done, total)` counts the steps
+/// of the phase; each phase (or its part after a resume) is reported once where it starts,
+/// before its first step, then every [`REPORT_EVERY`] steps and at its end.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
     Settle,

@@ -148,6 +148,10 @@ pub(super) fn record_period(
         let stretch = period.count as u64 * period_steps;
         let mut dem = || -> Result<(), RecordError> {
             let mut k = start;
+            // where the stretch starts (mid-way after a resume), before its first step
+            if k < period_steps {
+                progress(Phase::Period, first + k, stretch);
+            }
             while k < period_steps {
                 // sample k is the contact list that conducted during DEM step k, from
                 // t0 + k dt to t0 + (k+1) dt: the list the step has just computed
