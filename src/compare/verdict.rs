@@ -130,8 +130,8 @@ impl Verdict {
     /// 1 are named. The `t_k` where the extrapolation was still the recorded run
     /// ([`PeriodComparison::within_recording`]) are left out: there it is the DEM itself.
     /// Where the twins parted from the reference after the extrapolation left it
-    /// ([`Departure::BeforeTheTwins`]), the judgement stands but says its floor is narrower than a fair
-    /// one.
+    /// ([`Departure::BeforeTheTwins`]), the judgement stands but says its floor is narrower
+    /// than a fair one.
     pub fn of(
         periods: &[PeriodComparison],
         dem_runs: usize,
@@ -238,11 +238,12 @@ impl Verdict {
             Departure::BeforeTheTwins { left, parted }
                 if dem_runs > 1 && median_ratio.is_some() =>
             {
+                let fair_from = parted + 1;
                 format!(
-                "; the twins parted from the DEM at t{parted}, after the extrapolation left it \
-                 (t{left}): their spread from t{} on is narrower than a fair floor for it",
-                parted + 1
-            )
+                    "; the twins parted from the DEM at t{parted}, after the extrapolation left \
+                     it (t{left}): their spread from t{fair_from} on is narrower than a fair \
+                     floor for it"
+                )
             }
             _ => String::new(),
         };
