@@ -62,37 +62,30 @@ fn simulate(plan: &RunPlan) -> Result<RunSummary> {
     let wall_start = Instant::now();
 
     // a log for a run in the background, where the bar is not drawn; each phase is reported
-    // once before its first step (PhaseLog::report)
+    // once before its first step (PhaseLog::report), then every `every` steps
     let mut log = crate::progress::PhaseLog::on_stderr();
-    let mut logged = |name: &str, done: u64, total: u64| {
-        if let Some(log) = &mut log {
-            log.report(name, done, total);
-        }
+    let mut phase = |sim: &mut Simulation, name: &str, steps: u64, before: u64| {
+        bar.set_message(name.to_string());
+        let mut logged = |done: u64| {
+            if let Some(log) = &mut log {
+                log.report(name, done, steps);
+            }
+        };
+        logged(0);
+        sim.run(steps, every, &mut |s| {
+            bar.set_position(before + s);
+            logged(s);
+        })
     };
 
-    bar.set_message("settle");
-    logged("settle", 0, n_settle);
-    sim.run(n_settle, every, &mut |s| {
-        bar.set_position(s);
-        logged("settle", s, n_settle);
-    })?;
-    bar.set_message("spin-up");
+    phase(&mut sim, "settle", n_settle, 0)?;
     sim.start_rotation();
-    logged("spin-up", 0, n_spin);
-    sim.run(n_spin, every, &mut |s| {
-        bar.set_position(n_settle + s);
-        logged("spin-up", s, n_spin);
-    })?;
+    phase(&mut sim, "spin-up", n_spin, n_settle)?;
 
     sim.assign_temperatures();
     let start = sim.heat_summary();
-    bar.set_message("heating");
     let before_heating = sim.counters.clone();
-    logged("heating", 0, n_heat);
-    sim.run(n_heat, every, &mut |s| {
-        bar.set_position(n_settle + n_spin + s);
-        logged("heating", s, n_heat);
-    })?;
+    phase(&mut sim, "heating", n_heat, n_settle + n_spin)?;
     let end = sim.heat_summary();
     bar.finish_and_clear();
 
