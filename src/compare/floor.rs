@@ -234,44 +234,29 @@ mod tests {
                 temp: &t_twin,
             },
         ];
+        // one more run, measured to both
+        let with = Departure::WithTheTwins;
         // the extrapolation halfway between them: 0.5 K from each
-        let f = floor(
-            &cells(),
-            &runs,
-            &[Some(16.0), Some(35.0)],
-            Departure::WithTheTwins,
-        )
-        .unwrap();
+        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)], with).unwrap();
         assert_eq!(f.floor_eps_abs, 1.0);
         assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         assert_eq!(f.ratio_to_floor, Some(0.5));
         assert!(within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
         // a field 3 K off in the first cell is farther than the runs are from each other
-        let far = floor(
-            &cells(),
-            &runs,
-            &[Some(19.0), Some(35.0)],
-            Departure::WithTheTwins,
-        )
-        .unwrap();
+        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)], with).unwrap();
         assert_eq!(far.eps_abs_to_dem_runs, 1.5);
         assert_eq!(far.ratio_to_floor, Some(1.5));
         assert!(!within(far.eps_abs_to_dem_runs, far.floor_eps_abs_max));
         // one run alone has no floor
         assert_eq!(
-            floor(
-                &cells(),
-                &runs[..1],
-                &[Some(15.0), Some(35.0)],
-                Departure::WithTheTwins
-            ),
+            floor(&cells(), &runs[..1], &[Some(15.0), Some(35.0)], with),
             None
         );
         // the field of the DEM itself (an extrapolation still on the reference): half the
         // floor to both runs, the whole floor to the twin alone
         let on_dem = [Some(15.0), Some(35.0)];
-        let all = floor(&cells(), &runs, &on_dem, Departure::WithTheTwins).unwrap();
+        let all = floor(&cells(), &runs, &on_dem, with).unwrap();
         assert_eq!(all.ratio_to_floor, Some(0.5));
         let twins = floor(&cells(), &runs, &on_dem, Departure::of(2, 1)).unwrap();
         assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
