@@ -464,6 +464,18 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
         text.contains("t2 left out, where the extrapolation is still the recorded run"),
         "{text}"
     );
+    // the reader is told the reference was left out, in the verdict, the JSON and the table
+    let measured_to = "the DEM runs other than the reference (it is the reference until t2; the \
+                       twins parted at t1)";
+    assert!(
+        text.ends_with(&format!("; its distance measured to {measured_to}")),
+        "{text}"
+    );
+    assert_eq!(
+        v["departure"],
+        serde_json::json!({"kind": "after_the_twins", "left": 2, "parted": 1}),
+        "{v}"
+    );
     let table = tdex_ok(&[
         "compare",
         rec.to_str().unwrap(),
@@ -476,9 +488,23 @@ fn the_verdict_leaves_out_the_recorded_stretch() {
         .find(|l| l.trim_start().starts_with("2 "))
         .unwrap();
     assert!(t2.contains(" ("), "t2's ratio in parentheses: {table}");
+    assert!(
+        table.contains(&format!(
+            "ratio = the second field's mean eps_abs to {measured_to} / mean floor"
+        )),
+        "{table}"
+    );
 
     // one recorded period: every t_k is the extrapolation's own, measured to both runs
     let v = compare(&x1);
+    assert!(v.get("departure").is_none(), "{v}");
+    assert!(
+        !v["verdict"]["text"]
+            .as_str()
+            .unwrap()
+            .contains("measured to"),
+        "{v}"
+    );
     assert!(ks(&v, "within_recording").is_empty(), "{v}");
     assert_eq!(ks(&v, "compared"), [2, 3, 4]);
     for p in v["periods"].as_array().unwrap() {
@@ -529,8 +555,10 @@ fn twins_that_part_where_the_extrapolation_starts() {
         assert!(p["floor_eps_abs"].as_f64().unwrap() > 0.0, "{p}");
     }
     assert_eq!(v["verdict"]["compared"], serde_json::json!([3, 4]), "{v}");
+    assert!(v.get("departure").is_none(), "{v}");
     let text = v["verdict"]["text"].as_str().unwrap();
     assert!(!text.contains("parted from the DEM at"), "{text}");
+    assert!(!text.contains("measured to"), "{text}");
 
     let v = compare(&x1);
     // t2, where the runs are still one, has no floor: neither a ratio nor a range to leave
@@ -549,6 +577,11 @@ fn twins_that_part_where_the_extrapolation_starts() {
              spread from t3 on is narrower than a fair floor for it"
         ),
         "{text}"
+    );
+    assert_eq!(
+        v["departure"],
+        serde_json::json!({"kind": "before_the_twins", "left": 1, "parted": 2}),
+        "{v}"
     );
 
     for (flags, says) in [

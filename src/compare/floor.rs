@@ -43,7 +43,8 @@ pub struct Field<'a> {
 /// Where the second field left the reference, against where the twins parted from it: which
 /// DEM runs its distance is measured to, and whether their spread is a fair floor for it. One
 /// answer to both, so that the distance and the verdict's caveat cannot disagree.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
 pub enum Departure {
     /// Where the twins part (the paper's method, twins from the extrapolation's start), or a
     /// second DEM run: one more run, measured to all of them.
@@ -79,6 +80,25 @@ impl Departure {
     /// Whether the reference (the first run) is left out of the runs its distance goes to.
     fn skips_the_reference(self) -> bool {
         matches!(self, Departure::AfterTheTwins { .. })
+    }
+
+    /// The one a second DEM run or the paper's method has; left out of `tdex compare
+    /// --json`, so that their outputs keep their bytes.
+    pub fn is_with_the_twins(&self) -> bool {
+        *self == Departure::WithTheTwins
+    }
+
+    /// The runs the distance goes to when they are not all of them, in words for the
+    /// outputs ("its mean distance to …"), so that a reader is never told "the DEM runs"
+    /// where the reference was left out.
+    pub fn runs_measured_to(self) -> Option<String> {
+        match self {
+            Departure::AfterTheTwins { left, parted } => Some(format!(
+                "the DEM runs other than the reference (it is the reference until t{left}; \
+                 the twins parted at t{parted})"
+            )),
+            Departure::WithTheTwins | Departure::BeforeTheTwins { .. } => None,
+        }
     }
 }
 
@@ -186,6 +206,16 @@ mod tests {
         assert!(never.skips_the_reference());
         assert!(!WithTheTwins.skips_the_reference());
         assert!(!Departure::of(1, 2).skips_the_reference());
+        // and the outputs say so where (and only where) the reference is left out
+        assert_eq!(
+            Departure::of(2, 1).runs_measured_to().as_deref(),
+            Some(
+                "the DEM runs other than the reference (it is the reference until t2; the \
+                 twins parted at t1)"
+            )
+        );
+        assert_eq!(WithTheTwins.runs_measured_to(), None);
+        assert_eq!(Departure::of(1, 2).runs_measured_to(), None);
     }
 
     fn cells() -> Cells {

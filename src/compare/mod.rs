@@ -56,6 +56,10 @@ pub struct Comparison {
     /// DEM runs that measure the floor: the reference, its twins and any further runs given
     /// (1: no floor).
     pub dem_runs: usize,
+    /// Which of them the second field's distance goes to, and how fair their spread is for
+    /// it; left out of the JSON when it is all of them from where they part.
+    #[serde(skip_serializing_if = "floor::Departure::is_with_the_twins")]
+    pub departure: floor::Departure,
     /// What `eps_rel` divides by.
     pub contrast: ContrastKind,
     /// One entry per extrapolated `t_k` that has a DEM reference (k ≥ 2; k ≥ 1 against a
@@ -562,6 +566,7 @@ pub fn compare_runs(
         hot_particles,
         cold_particles,
         dem_runs: 1 + others.len(),
+        departure,
         contrast: contrast_kind,
         periods,
         dem_series,
@@ -677,8 +682,11 @@ pub fn table(c: &Comparison) -> String {
     if floors {
         s += &format!(
             "; floor = eps_abs between {} DEM runs (mean, max); ratio = the second field's \
-             mean eps_abs to them / mean floor",
-            c.dem_runs
+             mean eps_abs to {} / mean floor",
+            c.dem_runs,
+            c.departure
+                .runs_measured_to()
+                .unwrap_or_else(|| "them".to_string())
         );
     }
     s += "; temperatures in K\n";

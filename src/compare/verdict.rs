@@ -131,7 +131,8 @@ impl Verdict {
     /// ([`PeriodComparison::within_recording`]) are left out: there it is the DEM itself.
     /// Where the twins parted from the reference after the extrapolation left it
     /// ([`Departure::BeforeTheTwins`]), the judgement stands but says its floor is narrower
-    /// than a fair one.
+    /// than a fair one; where its distance went to the runs other than the reference
+    /// ([`Departure::AfterTheTwins`]), it says so.
     pub fn of(
         periods: &[PeriodComparison],
         dem_runs: usize,
@@ -234,10 +235,11 @@ impl Verdict {
                 instants(&within_recording, within_recording.len())
             )
         };
-        let late_parting = match departure {
-            Departure::BeforeTheTwins { left, parted }
-                if dem_runs > 1 && median_ratio.is_some() =>
-            {
+        // which runs its distance went to and how fair their spread is, where it is not
+        // simply all of them
+        let runs_note = match departure {
+            _ if dem_runs < 2 || median_ratio.is_none() => String::new(),
+            Departure::BeforeTheTwins { left, parted } => {
                 let fair_from = parted + 1;
                 format!(
                     "; the twins parted from the DEM at t{parted}, after the extrapolation left \
@@ -245,13 +247,17 @@ impl Verdict {
                      floor for it"
                 )
             }
-            _ => String::new(),
+            Departure::AfterTheTwins { .. } | Departure::WithTheTwins => {
+                departure.runs_measured_to().map_or(String::new(), |runs| {
+                    format!("; its distance measured to {runs}")
+                })
+            }
         };
         let text = match (passes, median_ratio) {
             (Some(true), Some(m)) => format!(
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
                  theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}\
-                 {late_parting}",
+                 {runs_note}",
                 instants(&compared, compared.len()),
                 beside_one(m),
                 if outside_range.is_empty() {
@@ -295,7 +301,7 @@ impl Verdict {
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
                      each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}\
-                     {late_parting}",
+                     {runs_note}",
                     instants(&compared, compared.len()),
                     if m > 1.0 {
                         format!("{} > 1", above_one(m))
@@ -542,6 +548,19 @@ mod tests {
         );
         let alone = Verdict::of(&periods, 1, late, ContrastKind::HotCold);
         assert!(!alone.text.contains("twins parted"), "{}", alone.text);
+        // measured without the reference (it followed the reference past the parting): the
+        // same judgement, which says so
+        let after = Departure::AfterTheTwins { left: 3, parted: 2 };
+        let v = Verdict::of(&periods, 2, after, ContrastKind::HotCold);
+        assert_eq!((v.passes, v.median_ratio), (fair.passes, fair.median_ratio));
+        assert_eq!(
+            v.text,
+            format!(
+                "{}; its distance measured to the DEM runs other than the reference (it is the \
+                 reference until t3; the twins parted at t2)",
+                fair.text
+            )
+        );
     }
 
     #[test]

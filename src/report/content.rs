@@ -637,9 +637,12 @@ fn errors_section(d: &mut Document, c: &Comparison) {
             text(format!(
                 ": two DEM runs of a chaotic flow part at the particle scale, so ε_abs between \
                  the {} DEM runs (the reference and its twins) is the floor no extrapolation can \
-                 beat; the extrapolation's mean ε_abs to those runs over the floor is its ratio \
-                 to the floor (1: as far from them as they are from each other).",
-                c.dem_runs
+                 beat; the extrapolation's mean ε_abs to {} over the floor is its ratio to the \
+                 floor (1: as far from them as they are from each other).",
+                c.dem_runs,
+                c.departure
+                    .runs_measured_to()
+                    .unwrap_or_else(|| "those runs".to_string())
             )),
         ]));
     }
