@@ -296,8 +296,18 @@ struct CheckpointInspection {
     steps_total: u64,
     /// Wall-clock seconds the run has taken to this checkpoint (over all its resumptions).
     wall_seconds: f64,
-    /// `wall_seconds` scaled to the steps left; absent before any step.
+    /// The part of the run it stands in (settling and spin-up, recorded periods, reference
+    /// periods, twins), its steps and its wall time so far.
+    part: recorder::record::Part,
+    steps_done_in_part: u64,
+    part_wall_seconds: f64,
+    /// The steps left at the pace of the part running now (its steps over its wall time),
+    /// or of the whole run so far when that part has not run a step yet; absent before any
+    /// step. The part's pace, not the whole run's: settling is slower per step, and a
+    /// machine shared earlier in the run says nothing of the pace now.
     seconds_left_at_this_pace: Option<f64>,
+    /// Whose pace `seconds_left_at_this_pace` is: the part's (true) or the whole run's.
+    pace_of_the_part: bool,
     resume: String,
 }
 
@@ -309,6 +319,13 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
     let e = &checkpoint.elapsed;
     let wall_seconds = e.to_t0 + e.period + e.reference + e.twins;
     let left = steps.total - steps.done;
+    let part_wall_seconds = steps.part.seconds(e);
+    let pace_of_the_part = steps.done_in_part > 0 && part_wall_seconds > 0.0;
+    let seconds_per_step = if pace_of_the_part {
+        Some(part_wall_seconds / steps.done_in_part as f64)
+    } else {
+        (steps.done > 0).then(|| wall_seconds / steps.done as f64)
+    };
     let stands_at = checkpoint.stands_at(&case);
     let o = &checkpoint.options;
     let inspection = CheckpointInspection {
@@ -327,11 +344,25 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
         steps_done: steps.done,
         steps_total: steps.total,
         wall_seconds,
-        seconds_left_at_this_pace: (steps.done > 0)
-            .then(|| wall_seconds * left as f64 / steps.done as f64),
+        part: steps.part,
+        steps_done_in_part: steps.done_in_part,
+        part_wall_seconds,
+        seconds_left_at_this_pace: seconds_per_step.map(|s| s * left as f64),
+        pace_of_the_part,
         resume: format!("tdex record --resume {}", plan.file.display()),
     };
     emit(plan.json, &inspection, print_checkpoint)
+}
+
+/// A part of a run in words: "the twins".
+fn part_words(part: recorder::record::Part) -> &'static str {
+    use recorder::record::Part;
+    match part {
+        Part::ToT0 => "the settling and spin-up",
+        Part::Recorded => "the recorded periods",
+        Part::Reference => "the reference periods",
+        Part::Twins => "the twins",
+    }
 }
 
 /// `, 2 DEM twins from t1` (empty without twins), after the reference periods.
@@ -368,8 +399,18 @@ fn print_checkpoint(c: &CheckpointInspection) {
         crate::progress::duration(std::time::Duration::from_secs_f64(c.wall_seconds.max(0.0)))
     );
     if let Some(left) = c.seconds_left_at_this_pace {
+        let pace = if c.pace_of_the_part {
+            let per_minute = 60.0 * c.steps_done_in_part as f64 / c.part_wall_seconds;
+            format!(
+                "the pace of {} so far ({} steps a minute)",
+                part_words(c.part),
+                per_minute.round()
+            )
+        } else {
+            "the pace so far".to_string()
+        };
         println!(
-            "left          about {} at the pace so far",
+            "left          about {} at {pace}",
             crate::progress::duration(std::time::Duration::from_secs_f64(left.clamp(0.0, 1e9)))
         );
     }

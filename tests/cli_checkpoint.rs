@@ -441,6 +441,33 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
     assert!((3000 + 12000..3000 + 18000).contains(&done[1]), "{done:?}");
     assert!((3000 + 18000..3000 + 24000).contains(&done[2]), "{done:?}");
     assert!((3000 + 24000..total).contains(&done[3]), "{done:?}");
+    // the time left goes at the pace of the part the run stands in, whose steps start after
+    // the settling and spin-up (3 000), the recorded periods (+ 12 000) and the run's
+    // reference period (+ 6 000)
+    for (s, (part, starts_at)) in stands.iter().zip([
+        ("recorded", 3000),
+        ("reference", 15000),
+        ("twins", 21000),
+        ("twins", 21000),
+    ]) {
+        assert_eq!(s["part"], part, "{s}");
+        let in_part = s["steps_done_in_part"].as_u64().unwrap();
+        assert_eq!(
+            in_part,
+            s["steps_done"].as_u64().unwrap() - starts_at,
+            "{s}"
+        );
+        if in_part > 0 {
+            assert_eq!(s["pace_of_the_part"], true, "{s}");
+            let (wall, left) = (
+                s["part_wall_seconds"].as_f64().unwrap(),
+                s["seconds_left_at_this_pace"].as_f64().unwrap(),
+            );
+            let steps_left = total - s["steps_done"].as_u64().unwrap();
+            let expected = wall / in_part as f64 * steps_left as f64;
+            assert!((left - expected).abs() <= 1e-9 * expected, "{s}");
+        }
+    }
     resume_to_the_end(&ck_arg, &a, &b, &stops);
     let rec = tdex_format::RecordingReader::open(&a).unwrap();
     assert_eq!(rec.info().twins_from, 2);
@@ -467,6 +494,12 @@ fn inspect_checkpoint(ck: &Path) -> serde_json::Value {
     let text = String::from_utf8_lossy(&o.stdout);
     assert!(
         text.contains(&format!("continue with tdex record --resume {ck}")),
+        "{text}"
+    );
+    let left = text.lines().find(|l| l.starts_with("left ")).unwrap();
+    assert!(
+        left.contains(" at the pace of the ") && left.ends_with(" steps a minute)")
+            || left.ends_with(" at the pace so far"),
         "{text}"
     );
     let o = run_tdex(&["inspect", ck, "--json"]);

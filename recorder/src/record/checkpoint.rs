@@ -58,6 +58,38 @@ pub fn is_checkpoint(path: &Path) -> bool {
 pub struct StepsDone {
     pub done: u64,
     pub total: u64,
+    /// The part of the run it stands in, and the steps run in that part so far: with its
+    /// wall time ([`Part::seconds`]), the pace of the part running now, which the pace of
+    /// the whole run (its settling, a machine shared earlier) need not be.
+    pub part: Part,
+    pub done_in_part: u64,
+}
+
+/// The parts of a run whose wall times a checkpoint's [`Elapsed`] counts apart, in the order
+/// the run goes through them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Part {
+    /// Settling and spin-up.
+    ToT0,
+    /// The recorded periods (DEM and recorder).
+    Recorded,
+    /// The run's reference periods after the recorded ones.
+    Reference,
+    /// The DEM twins.
+    Twins,
+}
+
+impl Part {
+    /// The wall time spent in this part so far.
+    pub fn seconds(self, elapsed: &Elapsed) -> f64 {
+        match self {
+            Part::ToT0 => elapsed.to_t0,
+            Part::Recorded => elapsed.period,
+            Part::Reference => elapsed.reference,
+            Part::Twins => elapsed.twins,
+        }
+    }
 }
 
 /// Where the checkpoints of a recording to `dest` go: `<dest>.checkpoint`.
@@ -239,11 +271,18 @@ fn steps_done(opts: &RecordOptions, settle: u64, spin_up: u64, stage: Stage) -> 
     let twin_periods = u64::from((opts.reference_periods + 1).saturating_sub(opts.twins_from));
     let twins_at = to_t0 + run_periods * period;
     let total = twins_at + u64::from(opts.twins) * twin_periods * period;
-    let done = match stage {
-        Stage::Settle { done } => done,
-        Stage::SpinUp { done } => settle + done,
-        Stage::Period { period: p, done } => to_t0 + u64::from(p) * period + done,
-        Stage::Reference { period: p, done } => to_t0 + (u64::from(p) + 1) * period + done,
+    let reference_at = to_t0 + u64::from(opts.recorded_periods) * period;
+    let (done, part, part_at) = match stage {
+        Stage::Settle { done } => (done, Part::ToT0, 0),
+        Stage::SpinUp { done } => (settle + done, Part::ToT0, 0),
+        Stage::Period { period: p, done } => {
+            (to_t0 + u64::from(p) * period + done, Part::Recorded, to_t0)
+        }
+        Stage::Reference { period: p, done } => (
+            to_t0 + (u64::from(p) + 1) * period + done,
+            Part::Reference,
+            reference_at,
+        ),
         Stage::Twin {
             twin,
             period: p,
@@ -251,12 +290,16 @@ fn steps_done(opts: &RecordOptions, settle: u64, spin_up: u64, stage: Stage) -> 
         } => {
             // before its parting a twin is the run (period 0: not started)
             let own = u64::from(p.saturating_sub(opts.twins_from.saturating_sub(1)));
-            twins_at + u64::from(twin - 1) * twin_periods * period + own * period + done
+            let done = twins_at + u64::from(twin - 1) * twin_periods * period + own * period + done;
+            (done, Part::Twins, twins_at)
         }
     };
+    let done = done.min(total);
     StepsDone {
-        done: done.min(total),
+        done,
         total,
+        part,
+        done_in_part: done.saturating_sub(part_at),
     }
 }
 
@@ -590,9 +633,15 @@ mod tests {
         let total = 500 + 7 * 1000 + 5 * 1000;
         assert_eq!(
             at(Stage::Settle { done: 40 }),
-            StepsDone { done: 40, total }
+            StepsDone {
+                done: 40,
+                total,
+                part: Part::ToT0,
+                done_in_part: 40
+            }
         );
         assert_eq!(at(Stage::SpinUp { done: 40 }).done, 140);
+        assert_eq!(at(Stage::SpinUp { done: 40 }).done_in_part, 140);
         assert_eq!(
             at(Stage::Period {
                 period: 1,
@@ -601,14 +650,23 @@ mod tests {
             .done,
             500 + 1040
         );
-        // the first reference period after two recorded ones runs from t2 (index 1)
+        let recorded = at(Stage::Period {
+            period: 1,
+            done: 40,
+        });
         assert_eq!(
-            at(Stage::Reference {
-                period: 1,
-                done: 40
-            })
-            .done,
-            500 + 2040
+            (recorded.part, recorded.done_in_part),
+            (Part::Recorded, 1040)
+        );
+        // the first reference period after two recorded ones runs from t2 (index 1)
+        let reference = at(Stage::Reference {
+            period: 1,
+            done: 40,
+        });
+        assert_eq!(reference.done, 500 + 2040);
+        assert_eq!(
+            (reference.part, reference.done_in_part),
+            (Part::Reference, 40)
         );
         assert_eq!(
             at(Stage::Reference {
@@ -644,6 +702,8 @@ mod tests {
         );
         assert_eq!(second.total, 500 + 7000 + 2 * 6000);
         assert_eq!(second.done, 500 + 7000 + 6000 + 3000);
+        // the twins' part counts both twins' steps
+        assert_eq!((second.part, second.done_in_part), (Part::Twins, 9000));
         // no reference: the run ends at tP
         assert_eq!(
             steps_done(&options(3, 0, 0, 1), 0, 0, Stage::Settle { done: 0 }).total,

@@ -19,7 +19,7 @@ mod saver;
 pub mod splitter;
 
 pub use checkpoint::{
-    checkpoint_path, is_checkpoint, Checkpoint, CheckpointError, Stage, StepsDone,
+    checkpoint_path, is_checkpoint, Checkpoint, CheckpointError, Part, Stage, StepsDone,
 };
 pub use driver::{
     record, record_from_t0, record_many_from_t0, record_run, resume, run_to_t0, twin_of,
