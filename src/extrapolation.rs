@@ -309,7 +309,7 @@ fn memory_statement(memory: &MemoryPlan, limit: &MemoryLimit) -> String {
         format!("no limit ({})", limit.source)
     };
     let parts = format!(
-        "table {} ({} rows × {} B), particles {}, pairing {}, buffers {}",
+        "table {} = {} rows × {} B, particles {}, pairing {}, buffers {}",
         human_bytes(n.table_bytes),
         n.rows,
         replay::memory::ROW_BYTES,
