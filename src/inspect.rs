@@ -301,13 +301,8 @@ struct CheckpointInspection {
     part: recorder::record::Part,
     steps_done_in_part: u64,
     part_wall_seconds: f64,
-    /// The steps left at the pace of the part running now (its steps over its wall time),
-    /// or of the whole run so far when that part has not run a step yet; absent before any
-    /// step. The part's pace, not the whole run's: settling is slower per step, and a
-    /// machine shared earlier in the run says nothing of the pace now.
-    seconds_left_at_this_pace: Option<f64>,
-    /// Whose pace `seconds_left_at_this_pace` is: the part's (true) or the whole run's.
-    pace_of_the_part: bool,
+    /// The time left; absent before any step.
+    left: Option<TimeLeft>,
     resume: String,
 }
 
@@ -320,11 +315,10 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
     let wall_seconds = e.to_t0 + e.period + e.reference + e.twins;
     let left = steps.total - steps.done;
     let part_wall_seconds = steps.part.seconds(e);
-    let pace_of_the_part = steps.done_in_part > 0 && part_wall_seconds > 0.0;
-    let seconds_per_step = if pace_of_the_part {
-        Some(part_wall_seconds / steps.done_in_part as f64)
+    let pace = if steps.done_in_part > 0 && part_wall_seconds > 0.0 {
+        Some((steps.done_in_part, part_wall_seconds, PaceOf::ThePart))
     } else {
-        (steps.done > 0).then(|| wall_seconds / steps.done as f64)
+        (steps.done > 0).then_some((steps.done, wall_seconds, PaceOf::TheWholeRun))
     };
     let stands_at = checkpoint.stands_at(&case);
     let o = &checkpoint.options;
@@ -347,8 +341,11 @@ fn inspect_checkpoint(plan: &InspectPlan) -> Result<()> {
         part: steps.part,
         steps_done_in_part: steps.done_in_part,
         part_wall_seconds,
-        seconds_left_at_this_pace: seconds_per_step.map(|s| s * left as f64),
-        pace_of_the_part,
+        left: pace.map(|(steps, seconds, pace_of)| TimeLeft {
+            seconds: seconds / steps as f64 * left as f64,
+            steps_per_minute: 60.0 * steps as f64 / seconds,
+            pace_of,
+        }),
         resume: format!("tdex record --resume {}", plan.file.display()),
     };
     emit(plan.json, &inspection, print_checkpoint)
@@ -363,6 +360,25 @@ fn part_words(part: recorder::record::Part) -> &'static str {
         Part::Reference => "the reference periods",
         Part::Twins => "the twins",
     }
+}
+
+/// The steps left of a checkpointed run at a pace it has kept.
+#[derive(Debug, Serialize)]
+struct TimeLeft {
+    seconds: f64,
+    steps_per_minute: f64,
+    pace_of: PaceOf,
+}
+
+/// Whose pace [`TimeLeft`] goes at: the part the run stands in (its steps over its wall
+/// time), or the whole run so far when that part has not run a step yet. The part's by
+/// choice: settling is slower per step, and a machine shared earlier in the run says nothing
+/// of the pace now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+enum PaceOf {
+    ThePart,
+    TheWholeRun,
 }
 
 /// `, 2 DEM twins from t1` (empty without twins), after the reference periods.
@@ -398,20 +414,20 @@ fn print_checkpoint(c: &CheckpointInspection) {
         100.0 * c.steps_done as f64 / c.steps_total.max(1) as f64,
         crate::progress::duration(std::time::Duration::from_secs_f64(c.wall_seconds.max(0.0)))
     );
-    if let Some(left) = c.seconds_left_at_this_pace {
-        let pace = if c.pace_of_the_part {
-            let per_minute = 60.0 * c.steps_done_in_part as f64 / c.part_wall_seconds;
-            format!(
+    if let Some(left) = &c.left {
+        let pace = match left.pace_of {
+            PaceOf::ThePart => format!(
                 "the pace of {} so far ({} steps a minute)",
                 part_words(c.part),
-                per_minute.round()
-            )
-        } else {
-            "the pace so far".to_string()
+                left.steps_per_minute.round()
+            ),
+            PaceOf::TheWholeRun => "the pace so far".to_string(),
         };
         println!(
             "left          about {} at {pace}",
-            crate::progress::duration(std::time::Duration::from_secs_f64(left.clamp(0.0, 1e9)))
+            crate::progress::duration(std::time::Duration::from_secs_f64(
+                left.seconds.clamp(0.0, 1e9)
+            ))
         );
     }
     println!("continue with {}", c.resume);

@@ -458,10 +458,10 @@ fn twins_parting_at_t2_resume_to_the_same_bytes_and_hold_the_runs_t2() {
             "{s}"
         );
         if in_part > 0 {
-            assert_eq!(s["pace_of_the_part"], true, "{s}");
+            assert_eq!(s["left"]["pace_of"], "the_part", "{s}");
             let (wall, left) = (
                 s["part_wall_seconds"].as_f64().unwrap(),
-                s["seconds_left_at_this_pace"].as_f64().unwrap(),
+                s["left"]["seconds"].as_f64().unwrap(),
             );
             let steps_left = total - s["steps_done"].as_u64().unwrap();
             let expected = wall / in_part as f64 * steps_left as f64;
