@@ -54,7 +54,12 @@ pub enum Departure {
     /// time to grow than the runs' distances to each other, which would flatter it. It is
     /// measured to all runs but the reference; the twins parted from that shared past at
     /// `t_parted`, as from each other.
-    AfterTheTwins { left: u32, parted: u32 },
+    AfterTheTwins {
+        /// `u32::MAX` for a path that never leaves the reference (null in the JSON).
+        #[serde(serialize_with = "snapshot_or_never")]
+        left: u32,
+        parted: u32,
+    },
     /// Before the twins parted at `t_parted` (`--twins-from` later than its start `t_left`):
     /// measured to all runs, but the twins followed the reference past its start, so their
     /// distances have had less time to grow than its own and their floor is narrower than a
@@ -93,13 +98,24 @@ impl Departure {
     /// where the reference was left out.
     pub fn runs_measured_to(self) -> Option<String> {
         match self {
-            Departure::AfterTheTwins { left, parted } => Some(format!(
-                "the DEM runs other than the reference (it is the reference until t{left}; \
-                 the twins parted at t{parted})"
-            )),
+            Departure::AfterTheTwins { left, parted } => {
+                let until = match left {
+                    u32::MAX => "throughout".to_string(),
+                    k => format!("until t{k}"),
+                };
+                Some(format!(
+                    "the DEM runs other than the reference (it is the reference {until}; the \
+                     twins parted at t{parted})"
+                ))
+            }
             Departure::WithTheTwins | Departure::BeforeTheTwins { .. } => None,
         }
     }
+}
+
+/// A snapshot index, `u32::MAX` (never) written as null.
+fn snapshot_or_never<S: serde::Serializer>(k: &u32, s: S) -> Result<S::Ok, S::Error> {
+    (*k != u32::MAX).then_some(*k).serialize(s)
 }
 
 /// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
@@ -213,6 +229,17 @@ mod tests {
                 "the DEM runs other than the reference (it is the reference until t2; the \
                  twins parted at t1)"
             )
+        );
+        assert_eq!(
+            never.runs_measured_to().as_deref(),
+            Some(
+                "the DEM runs other than the reference (it is the reference throughout; the \
+                 twins parted at t4)"
+            )
+        );
+        assert_eq!(
+            serde_json::to_value(never).unwrap(),
+            serde_json::json!({"kind": "after_the_twins", "left": null, "parted": 4})
         );
         assert_eq!(WithTheTwins.runs_measured_to(), None);
         assert_eq!(Departure::of(1, 2).runs_measured_to(), None);
