@@ -55,9 +55,8 @@ pub enum Departure {
     /// measured to all runs but the reference; the twins parted from that shared past at
     /// `t_parted`, as from each other.
     AfterTheTwins {
-        /// `u32::MAX` for a path that never leaves the reference (null in the JSON).
-        #[serde(serialize_with = "snapshot_or_never")]
-        left: u32,
+        /// `None` for a path that never leaves the reference.
+        left: Option<u32>,
         parted: u32,
     },
     /// Before the twins parted at `t_parted` (`--twins-from` later than its start `t_left`):
@@ -69,16 +68,18 @@ pub enum Departure {
 
 impl Departure {
     /// For a second field that is the reference until `t_recorded_until` (its first jump; 1
-    /// for the paper's method, `u32::MAX` for a path that never jumps, 0 for a DEM run) of a
+    /// for the paper's method, 0 for a DEM run, `None` for a path that never jumps) of a
     /// recording whose twins part at `t_twins_from`.
-    pub fn of(recorded_until: u32, twins_from: u32) -> Departure {
-        let (left, parted) = (recorded_until, twins_from);
-        if recorded_until >= 2 && recorded_until > twins_from {
-            Departure::AfterTheTwins { left, parted }
-        } else if (1..twins_from).contains(&recorded_until) {
-            Departure::BeforeTheTwins { left, parted }
-        } else {
-            Departure::WithTheTwins
+    pub fn of(recorded_until: Option<u32>, twins_from: u32) -> Departure {
+        let parted = twins_from;
+        match recorded_until {
+            None => Departure::AfterTheTwins { left: None, parted },
+            Some(left) if left >= 2 && left > parted => Departure::AfterTheTwins {
+                left: Some(left),
+                parted,
+            },
+            Some(left) if (1..parted).contains(&left) => Departure::BeforeTheTwins { left, parted },
+            Some(_) => Departure::WithTheTwins,
         }
     }
 
@@ -99,10 +100,7 @@ impl Departure {
     pub fn runs_measured_to(self) -> Option<String> {
         match self {
             Departure::AfterTheTwins { left, parted } => {
-                let until = match left {
-                    u32::MAX => "throughout".to_string(),
-                    k => format!("until t{k}"),
-                };
+                let until = left.map_or("throughout".to_string(), |k| format!("until t{k}"));
                 Some(format!(
                     "the DEM runs other than the reference (it is the reference {until}; the \
                      twins parted at t{parted})"
@@ -111,11 +109,6 @@ impl Departure {
             Departure::WithTheTwins | Departure::BeforeTheTwins { .. } => None,
         }
     }
-}
-
-/// A snapshot index, `u32::MAX` (never) written as null.
-fn snapshot_or_never<S: serde::Serializer>(k: &u32, s: S) -> Result<S::Ok, S::Error> {
-    (*k != u32::MAX).then_some(*k).serialize(s)
 }
 
 /// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
@@ -201,30 +194,51 @@ mod tests {
         use Departure::{AfterTheTwins, BeforeTheTwins, WithTheTwins};
         // the paper's method, twins that part where the extrapolation starts, a DEM run
         for (recorded_until, twins_from) in [(1, 1), (2, 2), (3, 3), (0, 1), (0, 3)] {
-            assert_eq!(Departure::of(recorded_until, twins_from), WithTheTwins);
+            assert_eq!(
+                Departure::of(Some(recorded_until), twins_from),
+                WithTheTwins
+            );
         }
         // several recorded periods, twins from t1 or from a snapshot before the start; a
-        // path that never jumps (u32::MAX) stays the reference throughout
-        assert_eq!(Departure::of(2, 1), AfterTheTwins { left: 2, parted: 1 });
-        assert_eq!(Departure::of(3, 2), AfterTheTwins { left: 3, parted: 2 });
-        let never = Departure::of(u32::MAX, 4);
+        // path that never jumps (None) stays the reference throughout
+        assert_eq!(
+            Departure::of(Some(2), 1),
+            AfterTheTwins {
+                left: Some(2),
+                parted: 1
+            }
+        );
+        assert_eq!(
+            Departure::of(Some(3), 2),
+            AfterTheTwins {
+                left: Some(3),
+                parted: 2
+            }
+        );
+        let never = Departure::of(None, 4);
         assert_eq!(
             never,
             AfterTheTwins {
-                left: u32::MAX,
+                left: None,
                 parted: 4
             }
         );
         // an extrapolation that starts before the twins part (its verdict says so)
-        assert_eq!(Departure::of(1, 2), BeforeTheTwins { left: 1, parted: 2 });
-        assert_eq!(Departure::of(2, 3), BeforeTheTwins { left: 2, parted: 3 });
+        assert_eq!(
+            Departure::of(Some(1), 2),
+            BeforeTheTwins { left: 1, parted: 2 }
+        );
+        assert_eq!(
+            Departure::of(Some(2), 3),
+            BeforeTheTwins { left: 2, parted: 3 }
+        );
         // the reference is left out only for one that followed it past the twins' parting
         assert!(never.skips_the_reference());
         assert!(!WithTheTwins.skips_the_reference());
-        assert!(!Departure::of(1, 2).skips_the_reference());
+        assert!(!Departure::of(Some(1), 2).skips_the_reference());
         // and the outputs say so where (and only where) the reference is left out
         assert_eq!(
-            Departure::of(2, 1).runs_measured_to().as_deref(),
+            Departure::of(Some(2), 1).runs_measured_to().as_deref(),
             Some(
                 "the DEM runs other than the reference (it is the reference until t2; the \
                  twins parted at t1)"
@@ -242,7 +256,7 @@ mod tests {
             serde_json::json!({"kind": "after_the_twins", "left": null, "parted": 4})
         );
         assert_eq!(WithTheTwins.runs_measured_to(), None);
-        assert_eq!(Departure::of(1, 2).runs_measured_to(), None);
+        assert_eq!(Departure::of(Some(1), 2).runs_measured_to(), None);
     }
 
     fn cells() -> Cells {
@@ -315,7 +329,7 @@ mod tests {
         let on_dem = [Some(15.0), Some(35.0)];
         let all = floor(&cells(), &runs, &on_dem, with).unwrap();
         assert_eq!(all.ratio_to_floor, Some(0.5));
-        let twins = floor(&cells(), &runs, &on_dem, Departure::of(2, 1)).unwrap();
+        let twins = floor(&cells(), &runs, &on_dem, Departure::of(Some(2), 1)).unwrap();
         assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
         assert_eq!(twins.ratio_to_floor, Some(1.0));
         assert_eq!(twins.floor_eps_abs, all.floor_eps_abs);

@@ -281,15 +281,16 @@ pub fn compare_runs(
         check_same_instants((recording, &dem), (run, &snaps))?;
         others.push(snaps);
     }
-    // The last snapshot index that is still the recorded run's (0: none, a second DEM run):
-    // periods 1 … j − 1 before the first jump j end at t2 … t_j.
+    // The last snapshot index that is still the recorded run's (0: none, a second DEM run;
+    // None: every one, a path that never jumps): periods 1 … j − 1 before the first jump j
+    // end at t2 … t_j.
     let recorded_until = match &second {
         Second::Extrapolation(extrapolation) => extrapolation
             .info()
             .roles
             .first_jump()
-            .map_or(u32::MAX, |j| u32::try_from(j).unwrap_or(u32::MAX)),
-        Second::Dem(_) => 0,
+            .and_then(|j| u32::try_from(j).ok()),
+        Second::Dem(_) => Some(0),
     };
     let (extra_path, extra, kind, own_groups) = match second {
         Second::Extrapolation(extrapolation) => {
@@ -543,7 +544,7 @@ pub fn compare_runs(
                 .iter()
                 .map(|s| metrics::bed_mean(&s.radius, &s.temp))
                 .collect(),
-            within_recording: after.index <= recorded_until,
+            within_recording: recorded_until.is_none_or(|until| after.index <= until),
         });
     }
     if periods.is_empty() {

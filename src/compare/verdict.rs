@@ -247,11 +247,9 @@ impl Verdict {
                      floor for it"
                 )
             }
-            Departure::AfterTheTwins { .. } | Departure::WithTheTwins => {
-                departure.runs_measured_to().map_or(String::new(), |runs| {
-                    format!("; its distance measured to {runs}")
-                })
-            }
+            _ => departure.runs_measured_to().map_or(String::new(), |runs| {
+                format!("; its distance measured to {runs}")
+            }),
         };
         let text = match (passes, median_ratio) {
             (Some(true), Some(m)) => format!(
@@ -550,7 +548,10 @@ mod tests {
         assert!(!alone.text.contains("twins parted"), "{}", alone.text);
         // measured without the reference (it followed the reference past the parting): the
         // same judgement, which says so
-        let after = Departure::AfterTheTwins { left: 3, parted: 2 };
+        let after = Departure::AfterTheTwins {
+            left: Some(3),
+            parted: 2,
+        };
         let v = Verdict::of(&periods, 2, after, ContrastKind::HotCold);
         assert_eq!((v.passes, v.median_ratio), (fair.passes, fair.median_ratio));
         assert_eq!(
