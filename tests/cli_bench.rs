@@ -73,3 +73,29 @@ fn the_liggghts_peer_runs_from_tdexs_bed_at_t0() {
     );
     assert!((q1 - q0).abs() <= 1e-9 * q0, "Q {q0} -> {q1}");
 }
+
+#[test]
+fn the_bench_names_the_vector_instructions_it_ran_with() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = short_small_drum(dir.path());
+    let bench = |simd: &str, json: bool| {
+        let mut command = std::process::Command::new(tdex());
+        command
+            .args(["bench", case.to_str().unwrap(), "--steps", "20"])
+            .args(["--threads", "1"])
+            .env("TDEX_SIMD", simd);
+        if json {
+            command.arg("--json");
+        }
+        let o = command.output().unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let json: serde_json::Value = serde_json::from_str(&bench("scalar", true)).unwrap();
+    assert_eq!(json["vector_instructions"], "scalar");
+    let text = bench("scalar", false);
+    assert!(
+        text.contains("vectors       none (one contact at a time)"),
+        "{text}"
+    );
+}

@@ -1,5 +1,6 @@
 //! `tdex record` and `tdex inspect` end to end on the tiny drum: the file reads back through
-//! the reader API, the Python MCAP readers and `inspect`; thread count does not change it;
+//! the reader API, the Python MCAP readers and `inspect`; neither the thread count nor the
+//! vector instructions change it;
 //! bad flags and damaged files give clear errors.
 
 use crate::cli_run::TINY_CASE;
@@ -23,17 +24,14 @@ fn write_case(dir: &Path, text: &str) -> PathBuf {
 
 /// Records `case` for τ = 0.1 s with `extra` flags, asserting success.
 fn record(case: &Path, out: &Path, extra: &[&str]) {
-    let mut args = vec![
-        "record",
-        case.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-        "--tau",
-        "0.1",
-        "--json",
-    ];
-    args.extend_from_slice(extra);
-    let o = run_tdex(&args);
+    record_in(std::process::Command::new(tdex()), case, out, extra);
+}
+
+/// [`record`] by `command` (tdex, with its environment set).
+fn record_in(mut command: std::process::Command, case: &Path, out: &Path, extra: &[&str]) {
+    let (case, out) = (case.to_str().unwrap(), out.to_str().unwrap());
+    command.args(["record", case, "-o", out, "--tau", "0.1", "--json"]);
+    let o = command.args(extra).output().expect("tdex starts");
     assert!(
         o.status.success(),
         "record failed: {}",
@@ -164,6 +162,52 @@ fn the_recording_is_byte_identical_whatever_the_thread_count_up_to_its_costs() {
     assert!(
         a[..ca] == b[..cb],
         "recordings differ before the costs record"
+    );
+}
+
+#[test]
+fn the_recording_is_byte_identical_whatever_the_vector_instructions_up_to_its_costs() {
+    // TDEX_SIMD caps the instructions the engine uses (the pair law on four-lane AVX2
+    // registers, one contact at a time, or the widest this CPU has); each must compute the
+    // same bits
+    let dir = tempfile::tempdir().unwrap();
+    let case = write_case(dir.path(), TINY_CASE);
+    let recording = |simd: Option<&str>| {
+        let out = dir
+            .path()
+            .join(format!("{}.mcap", simd.unwrap_or("widest")));
+        let mut command = std::process::Command::new(tdex());
+        match simd {
+            Some(simd) => command.env("TDEX_SIMD", simd),
+            None => command.env_remove("TDEX_SIMD"),
+        };
+        record_in(command, &case, &out, &["--threads", "1"]);
+        let bytes = std::fs::read(out).unwrap();
+        let costs = costs_record_offset(&bytes);
+        bytes[..costs].to_vec()
+    };
+    let widest = recording(None);
+    for simd in ["avx2", "scalar"] {
+        assert!(
+            recording(Some(simd)) == widest,
+            "TDEX_SIMD={simd} changed the recording"
+        );
+    }
+}
+
+#[test]
+fn a_vector_instruction_set_tdex_has_no_build_for_is_refused_before_any_work() {
+    let o = std::process::Command::new(tdex())
+        .args(["run", "cases/small_drum.toml"])
+        .current_dir(repo())
+        .env("TDEX_SIMD", "sse9")
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("TDEX_SIMD=\"sse9\"") && err.contains("avx512, avx2 or scalar"),
+        "{err}"
     );
 }
 

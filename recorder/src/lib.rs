@@ -24,6 +24,7 @@ pub mod particles;
 pub mod pipeline;
 pub mod prefetch;
 pub mod record;
+pub mod simd;
 pub mod simulation;
 pub mod slices;
 pub mod wall;

@@ -23,6 +23,8 @@ struct EngineBench {
     particles: usize,
     steps: u64,
     threads: usize,
+    /// The vector instructions of the engine's hot loops (`TDEX_SIMD` caps them).
+    vector_instructions: &'static str,
     seconds: f64,
     particle_steps_per_s: f64,
     /// Wall time of each stage over the timed steps, and its share of the stages' sum.
@@ -104,6 +106,7 @@ fn time_tdex(plan: &BenchPlan) -> Result<(EngineBench, Option<PathBuf>)> {
         particles: n,
         steps: plan.steps,
         threads: plan.threads,
+        vector_instructions: recorder::simd::Simd::in_use().name(),
         seconds,
         particle_steps_per_s: per_step_particle / seconds,
         stages,
@@ -124,6 +127,10 @@ fn print_table(r: &EngineBench) {
     println!(
         "{}: {} particles, {} steps after t0, {} threads",
         r.case, r.particles, r.steps, r.threads
+    );
+    println!(
+        "vectors       {}",
+        recorder::simd::Simd::in_use().describe()
     );
     println!(
         "tdex          {:.3e} particle-steps/s ({:.2} s)",

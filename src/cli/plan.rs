@@ -285,6 +285,9 @@ impl Plan {
     /// Checks the parsed flags of the command against the case file and each other, and
     /// builds its plan.
     pub fn from_args(cli: Cli) -> Result<Self> {
+        // the engine reads TDEX_SIMD when it first steps; a value it cannot use is refused
+        // here, before any work
+        recorder::simd::Simd::requested().map_err(|e| UsageError(e.to_string()))?;
         Ok(match cli.command {
             Command::Run(args) => Plan::Run(RunPlan::from_args(args)?),
             Command::Record(args) => Plan::Record(RecordPlan::from_args(args)?),

@@ -3,24 +3,24 @@
 use super::hertz_mindlin::ContactKinematics;
 use crate::math::*;
 
-/// One side of a sphere–sphere pair.
+/// One side of a sphere–sphere pair (`T`: one pair, or several in a vector register).
 #[derive(Debug, Clone, Copy)]
-pub struct SphereState {
-    pub pos: Vec3,
-    pub vel: Vec3,
-    pub omega: Vec3,
-    pub radius: f64,
-    pub mass: f64,
+pub struct SphereState<T = f64> {
+    pub pos: [T; 3],
+    pub vel: [T; 3],
+    pub omega: [T; 3],
+    pub radius: T,
+    pub mass: T,
 }
 
 /// A touching pair seen from `i`: the law's kinematics, the centre distance and both
 /// contact lever arms `R − δ/2`.
 #[derive(Debug, Clone, Copy)]
-pub struct PairContact {
-    pub kinematics: ContactKinematics,
-    pub distance: f64,
-    pub lever_i: f64,
-    pub lever_j: f64,
+pub struct PairContact<T = f64> {
+    pub kinematics: ContactKinematics<T>,
+    pub distance: T,
+    pub lever_i: T,
+    pub lever_j: T,
 }
 
 /// Whether spheres of radii `ri`, `rj` whose centres are `delta` apart overlap; the squared
@@ -42,19 +42,19 @@ pub fn effective(ri: f64, rj: f64, mi: f64, mj: f64) -> (f64, f64) {
 /// from [`overlapping`], and the pair's `(R*, m*)` from [`effective`] (passed in so that
 /// equal spheres compute it once).
 #[inline(always)]
-pub fn kinematics(
-    i: &SphereState,
-    j: &SphereState,
-    delta: Vec3,
-    r2: f64,
-    (r_eff, m_eff): (f64, f64),
-) -> PairContact {
+pub fn kinematics<T: Real>(
+    i: &SphereState<T>,
+    j: &SphereState<T>,
+    delta: [T; 3],
+    r2: T,
+    (r_eff, m_eff): (T, T),
+) -> PairContact<T> {
     let radsum = i.radius + j.radius;
     let r = r2.sqrt();
     let overlap = radsum - r;
-    let normal = scale(delta, 1.0 / r);
-    let lever_i = i.radius - 0.5 * overlap;
-    let lever_j = j.radius - 0.5 * overlap;
+    let normal = scale(delta, T::splat(1.0) / r);
+    let lever_i = i.radius - T::splat(0.5) * overlap;
+    let lever_j = j.radius - T::splat(0.5) * overlap;
     PairContact {
         kinematics: ContactKinematics {
             overlap,

@@ -3,15 +3,20 @@
 //! The contact scan's overlap test is a coin toss for the branch predictor; when the law runs
 //! right behind it, every miss throws away the law's long chain of roots and divisions in
 //! flight. Gathered here, the law runs over a batch without a branch (`hertz_mindlin` keeps
-//! both outcomes of each cap and selects), so the compiler evaluates several contacts per
-//! instruction, as wide as the CPU allows. Every lane does the same IEEE operations as a
-//! lone contact would, so the results do not depend on the width.
+//! both outcomes of each cap and selects), several contacts per instruction, as wide as the
+//! CPU allows ([`Simd`]): on AVX-512 the compiler vectorises the lane loop eight wide; on
+//! AVX2, where its cost model declines to, the law runs on four-lane registers (`F64x4`).
+//! Every lane does the same IEEE operations as a lone contact would, so the results do not
+//! depend on the width.
 
 use super::contact_sphere_sphere::{self as sphere_sphere, SphereState};
+#[cfg(target_arch = "x86_64")]
+use super::f64x4::F64x4;
 use super::{hertz_mindlin, ContactHistory, PairLaw};
 use crate::case::RollingModel;
 use crate::heat::ConductionLaw;
 use crate::math::*;
+use crate::simd::Simd;
 
 /// Contacts evaluated together: two AVX-512 vectors of doubles.
 pub const LANES: usize = 16;
@@ -43,6 +48,8 @@ pub struct PairResponse {
 /// Touching pairs, one array per field so each lane loop reads a vector; the first
 /// [`LANES`] are evaluated together.
 pub struct PairBatch {
+    /// The instructions the law runs with.
+    simd: Simd,
     len: usize,
     /// Contacts evaluated by the last `evaluate` (the first ones pushed).
     ready: usize,
@@ -79,9 +86,19 @@ struct Lanes {
 }
 
 impl Default for PairBatch {
+    /// A batch whose law runs with the instructions the engine uses ([`Simd::in_use`]).
     fn default() -> Self {
+        Self::with_simd(Simd::in_use())
+    }
+}
+
+impl PairBatch {
+    /// A batch whose law runs with `simd`, which this CPU must have.
+    pub fn with_simd(simd: Simd) -> Self {
+        assert!(simd <= Simd::detected(), "{simd:?} is not on this CPU");
         let zero = [0.0; LANES];
         Self {
+            simd,
             len: 0,
             ready: 0,
             evaluated: 0,
@@ -202,7 +219,14 @@ impl PairBatch {
             return;
         }
         self.gather(n, constants, spheres, old);
-        run_lanes(&mut self.lanes, &self.delta, &self.r2, n, constants);
+        run_lanes(
+            self.simd,
+            &mut self.lanes,
+            &self.delta,
+            &self.r2,
+            n,
+            constants,
+        );
         let lanes = &self.lanes;
         let new = &mut new[self.evaluated..self.evaluated + n];
         for (l, history) in new.iter_mut().enumerate() {
@@ -320,8 +344,9 @@ fn lane3<const N: usize>(a: &[[f64; N]; 3], l: usize) -> Vec3 {
     [a[0][l], a[1][l], a[2][l]]
 }
 
-/// Runs the law over the first `n` lanes with the widest vectors this CPU has.
+/// Runs the law over the first `n` lanes with the instructions `simd`.
 fn run_lanes(
+    simd: Simd,
     lanes: &mut Lanes,
     delta: &[[f64; CAPACITY]; 3],
     r2: &[f64; CAPACITY],
@@ -337,54 +362,88 @@ fn run_lanes(
             }
         };
     }
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU has AVX-512F, checked just above
-            return unsafe { with_model!(lanes_avx512) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2, checked just above
-            return unsafe { with_model!(lanes_avx2) };
-        }
+    match simd {
+        // SAFETY: a batch's `simd` is one the CPU has (`PairBatch::with_simd`)
+        #[cfg(target_arch = "x86_64")]
+        Simd::Avx512 => unsafe { with_model!(lanes_avx512) },
+        // SAFETY: as above
+        #[cfg(target_arch = "x86_64")]
+        Simd::Avx2 => unsafe { with_model!(lanes_avx2) },
+        _ => with_model!(lanes_scalar),
     }
-    with_model!(law_lanes)
 }
 
 const EPSD2: u8 = 0;
 const CDT: u8 = 1;
 const OFF: u8 = 2;
 
-/// `law_lanes` compiled for a CPU feature (called only once the feature is detected).
-macro_rules! law_lanes_for {
-    ($name:ident, $feature:literal) => {
-        #[cfg(target_arch = "x86_64")]
-        #[target_feature(enable = $feature)]
-        fn $name<const MODEL: u8>(
-            lanes: &mut Lanes,
-            delta: &[[f64; CAPACITY]; 3],
-            r2: &[f64; CAPACITY],
-            n: usize,
-            constants: &PairConstants,
-        ) {
-            law_lanes::<MODEL>(lanes, delta, r2, n, constants)
-        }
-    };
-}
-law_lanes_for!(lanes_avx512, "avx512f");
-// left scalar by the compiler (no packed root or division in it), yet measured 6 % faster
-// than the baseline build (docs/benchmarks.md)
-law_lanes_for!(lanes_avx2, "avx2");
-
-/// The law for lanes `0..n`: the same functions a lone contact goes through, inlined into a
-/// loop without branches.
+/// One contact at a time: the compiler vectorises this loop where its cost model allows
+/// (AVX-512) and leaves it scalar elsewhere.
 #[inline(always)]
-fn law_lanes<const MODEL: u8>(
+fn lanes_scalar<const MODEL: u8>(
     lanes: &mut Lanes,
     delta: &[[f64; CAPACITY]; 3],
     r2: &[f64; CAPACITY],
     n: usize,
     constants: &PairConstants,
+) {
+    let load = |a: &[f64]| a[0];
+    let store = |a: &mut [f64], x: f64| a[0] = x;
+    law_lanes::<MODEL, f64>(lanes, delta, r2, n, constants, 1, load, store)
+}
+
+/// The one-contact loop compiled for AVX-512, which the compiler vectorises eight wide.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn lanes_avx512<const MODEL: u8>(
+    lanes: &mut Lanes,
+    delta: &[[f64; CAPACITY]; 3],
+    r2: &[f64; CAPACITY],
+    n: usize,
+    constants: &PairConstants,
+) {
+    lanes_scalar::<MODEL>(lanes, delta, r2, n, constants)
+}
+
+/// Four contacts per [`F64x4`]: the compiler would leave the one-contact loop's AVX2 build
+/// scalar (docs/benchmarks.md, "A host without AVX-512").
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn lanes_avx2<const MODEL: u8>(
+    lanes: &mut Lanes,
+    delta: &[[f64; CAPACITY]; 3],
+    r2: &[f64; CAPACITY],
+    n: usize,
+    constants: &PairConstants,
+) {
+    let store = |a: &mut [f64], x: F64x4| x.store(a);
+    law_lanes::<MODEL, F64x4>(
+        lanes,
+        delta,
+        r2,
+        n,
+        constants,
+        F64x4::WIDTH,
+        F64x4::load,
+        store,
+    )
+}
+
+/// The law for lanes `0..n`, `width` contacts at a time in a `T` that `load` reads from the
+/// start of a lane array's slice and `store` writes there: the same functions a lone contact
+/// goes through, inlined into a loop without branches. The lanes from `n` up to the next
+/// multiple of `width` are evaluated too, on whatever the arrays hold there, and never read.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn law_lanes<const MODEL: u8, T: Real>(
+    lanes: &mut Lanes,
+    delta: &[[f64; CAPACITY]; 3],
+    r2: &[f64; CAPACITY],
+    n: usize,
+    constants: &PairConstants,
+    width: usize,
+    load: impl Fn(&[f64]) -> T,
+    store: impl Fn(&mut [f64], T),
 ) {
     let model = match MODEL {
         EPSD2 => RollingModel::Epsd2,
@@ -393,45 +452,48 @@ fn law_lanes<const MODEL: u8>(
     };
     let PairConstants { law, heat, dt, .. } = *constants;
     let n = n.min(LANES);
-    for l in 0..n {
-        let lane3 = |a: &[[f64; LANES]; 3]| lane3(a, l);
+    for chunk in 0..n.div_ceil(width) {
+        let l = chunk * width;
+        let at = |a: &[f64]| load(&a[l..]);
+        let at3 = |a: &[[f64; LANES]; 3]| [at(&a[0]), at(&a[1]), at(&a[2])];
         let si = SphereState {
-            pos: [0.0; 3], // the kinematics read only `delta`
-            vel: lane3(&lanes.vel_i),
-            omega: lane3(&lanes.omega_i),
-            radius: lanes.radius_i[l],
-            mass: 0.0, // (R*, m*) come in lane arrays
+            pos: [T::splat(0.0); 3], // the kinematics read only `delta`
+            vel: at3(&lanes.vel_i),
+            omega: at3(&lanes.omega_i),
+            radius: at(&lanes.radius_i),
+            mass: T::splat(0.0), // (R*, m*) come in lane arrays
         };
         let sj = SphereState {
-            vel: lane3(&lanes.vel_j),
-            omega: lane3(&lanes.omega_j),
-            radius: lanes.radius_j[l],
+            vel: at3(&lanes.vel_j),
+            omega: at3(&lanes.omega_j),
+            radius: at(&lanes.radius_j),
             ..si
         };
         let c = sphere_sphere::kinematics(
             &si,
             &sj,
-            [delta[0][l], delta[1][l], delta[2][l]],
-            r2[l],
-            (lanes.r_eff[l], lanes.m_eff[l]),
+            [at(&delta[0]), at(&delta[1]), at(&delta[2])],
+            at(r2),
+            (at(&lanes.r_eff), at(&lanes.m_eff)),
         );
         let mut history = ContactHistory {
-            shear: lane3(&lanes.shear),
-            roll: lane3(&lanes.roll),
+            shear: at3(&lanes.shear),
+            roll: at3(&lanes.roll),
         };
         let resp = hertz_mindlin::respond_with(model, law, &c.kinematics, &mut history, dt);
         let torque_i = resp.torque_on_i(c.lever_i);
         let torque_j = resp.torque_on_partner(c.lever_j);
-        let conductance =
-            heat.pair_conductivity * heat.pair_area(c.distance, si.radius, sj.radius).sqrt();
+        let conductance = T::splat(heat.pair_conductivity)
+            * heat.pair_area(c.distance, si.radius, sj.radius).sqrt();
+        let heat_flow = conductance * at(&lanes.temp_diff);
         for a in 0..3 {
-            lanes.shear[a][l] = history.shear[a];
-            lanes.roll[a][l] = history.roll[a];
-            lanes.force[a][l] = resp.force[a];
-            lanes.torque_i[a][l] = torque_i[a];
-            lanes.torque_j[a][l] = torque_j[a];
+            store(&mut lanes.shear[a][l..], history.shear[a]);
+            store(&mut lanes.roll[a][l..], history.roll[a]);
+            store(&mut lanes.force[a][l..], resp.force[a]);
+            store(&mut lanes.torque_i[a][l..], torque_i[a]);
+            store(&mut lanes.torque_j[a][l..], torque_j[a]);
         }
-        lanes.heat_flow[l] = conductance * lanes.temp_diff[l];
+        store(&mut lanes.heat_flow[l..], heat_flow);
     }
 }
 
@@ -508,6 +570,14 @@ mod tests {
 
     #[test]
     fn a_batch_gives_every_contact_the_bits_it_gets_alone() {
+        // every build this CPU can run: the scalar loop, AVX2's four-lane registers and the
+        // AVX-512 build of the loop
+        for simd in Simd::available() {
+            batch_against_lone_contacts(simd);
+        }
+    }
+
+    fn batch_against_lone_contacts(simd: Simd) {
         let coefficients = PairCoefficients {
             restitution: 0.2,
             friction: 0.3,
@@ -541,7 +611,7 @@ mod tests {
                 let start = &sample.history;
                 let mut batched = vec![ContactHistory::default(); start.len()];
                 let mut responses = vec![];
-                let mut batch = PairBatch::default();
+                let mut batch = PairBatch::with_simd(simd);
                 let mut evaluate = |batch: &mut PairBatch| {
                     batch.evaluate(&constants, &spheres, start, &mut batched);
                     responses.extend((0..batch.ready()).map(|l| batch.response(l)));
@@ -576,7 +646,11 @@ mod tests {
                         * heat.pair_area(c.distance, si.radius, sj.radius).sqrt()
                         * (temp[j] - temp[i]);
                     let bits = |v: Vec3| v.map(f64::to_bits);
-                    assert_eq!(bits(r.force), bits(resp.force), "{model:?} pair {p}");
+                    assert_eq!(
+                        bits(r.force),
+                        bits(resp.force),
+                        "{simd:?} {model:?} pair {p}"
+                    );
                     assert_eq!(bits(r.torque_owner), bits(resp.torque_on_i(c.lever_i)));
                     assert_eq!(
                         bits(r.torque_partner),

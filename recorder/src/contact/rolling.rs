@@ -10,34 +10,41 @@ use crate::math::*;
 /// both outcomes of each cap are computed and one kept (no branch, see `pair_batch`).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-pub fn torque(
+pub fn torque<T: Real>(
     model: RollingModel,
     law: &PairLaw,
-    k: &ContactKinematics,
-    kn: f64,
-    kt: f64,
-    fn_mag: f64,
-    spring: &mut Vec3,
+    k: &ContactKinematics<T>,
+    kn: T,
+    kt: T,
+    fn_mag: T,
+    spring: &mut [T; 3],
     dt: f64,
-) -> Vec3 {
+) -> [T; 3] {
     match model {
-        RollingModel::Off => [0.0; 3],
+        RollingModel::Off => [T::splat(0.0); 3],
         RollingModel::Epsd2 => {
             let wr_t = tangential(k.roll_omega, k.normal);
             let kr = kt * k.r_eff * k.r_eff;
-            let m = add(*spring, scale(wr_t, dt * kr));
-            let m_max = fn_mag.abs() * k.r_eff * law.rolling_friction;
+            let m = add(*spring, scale(wr_t, T::splat(dt) * kr));
+            let m_max = fn_mag.abs() * k.r_eff * T::splat(law.rolling_friction);
             let m_mag2 = norm2(m);
             let capped = scale(m, m_max / m_mag2.sqrt());
-            let m = select(m_mag2 > m_max * m_max, capped, m);
+            let m = select(m_mag2.gt(m_max * m_max), capped, m);
             *spring = m;
             m
         }
         RollingModel::Cdt => {
             let w = k.roll_omega;
             let w_mag = norm2(w).sqrt();
-            let m = scale(w, law.rolling_friction * kn * k.overlap * k.r_eff / w_mag);
-            select(w_mag > 0.0, tangential(m, k.normal), [0.0; 3])
+            let m = scale(
+                w,
+                T::splat(law.rolling_friction) * kn * k.overlap * k.r_eff / w_mag,
+            );
+            select(
+                w_mag.gt(T::splat(0.0)),
+                tangential(m, k.normal),
+                [T::splat(0.0); 3],
+            )
         }
     }
 }

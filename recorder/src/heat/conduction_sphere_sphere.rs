@@ -2,6 +2,7 @@
 //! (intersection disc) area or the Hertz circle, optionally with the Young's-modulus correction.
 
 use crate::case::{ConductionSpec, ContactArea};
+use crate::math::Real;
 
 /// Resolved conduction constants (one particle material).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,17 +40,20 @@ impl ConductionLaw {
         }
     }
 
-    /// Contact area of two spheres whose centres are `r` apart. Symmetric in (Ri, Rj) to the bit.
+    /// Contact area of two spheres whose centres are `r` apart (of one pair, or of several
+    /// in a vector register). Symmetric in (Ri, Rj) to the bit.
     #[inline(always)]
-    pub fn pair_area(&self, r: f64, ri: f64, rj: f64) -> f64 {
+    pub fn pair_area<T: Real>(&self, r: T, ri: T, rj: T) -> T {
         let radsum = ri + rj;
-        let overlap = (radsum - r) * self.overlap_correction;
+        let overlap = (radsum - r) * T::splat(self.overlap_correction);
         let r = radsum - overlap;
         let raddiff = ri - rj;
         let r2 = r * r;
-        let lens =
-            -std::f64::consts::FRAC_PI_4 * (r2 - radsum * radsum) * (r2 - raddiff * raddiff) / r2;
-        let hertz = std::f64::consts::PI * (ri * rj / radsum) * overlap;
+        let lens = T::splat(-std::f64::consts::FRAC_PI_4)
+            * (r2 - radsum * radsum)
+            * (r2 - raddiff * raddiff)
+            / r2;
+        let hertz = T::splat(std::f64::consts::PI) * (ri * rj / radsum) * overlap;
         // both computed, one kept: a select, which the batched pair law needs (`pair_batch`)
         if self.area == ContactArea::Overlap {
             lens
