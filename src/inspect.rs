@@ -624,8 +624,10 @@ fn print_human(s: &Inspection) {
             .map(|(k, v)| format!("{k} {v:.2} s"))
             .collect();
         println!(
-            "costs         {:.1} s to t0, {:.1} s period ({:.1} s recorder), {:.1} s reference; {} threads; stages {}",
-            c.seconds_to_t0, c.seconds_period, c.seconds_recorder, c.seconds_reference, c.threads, stages.join(", ")
+            "costs         {:.1} s to t0, {:.1} s period ({:.1} s recorder), {:.1} s reference; {} threads{}; stages {}",
+            c.seconds_to_t0, c.seconds_period, c.seconds_recorder, c.seconds_reference, c.threads,
+            crate::report::costs::vectors_clause(&c.vector_instructions),
+            stages.join(", ")
         );
     }
 }

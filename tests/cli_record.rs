@@ -193,6 +193,12 @@ fn the_recording_is_byte_identical_whatever_the_vector_instructions_up_to_its_co
             "TDEX_SIMD={simd} changed the recording"
         );
     }
+    // the costs, which depend on the instructions, say which ran
+    let scalar = dir.path().join("scalar.mcap");
+    let json = inspect_json(&scalar);
+    assert_eq!(json["costs"]["vector_instructions"], "scalar", "{json}");
+    let text = tdex_ok(&["inspect", scalar.to_str().unwrap()]);
+    assert!(text.contains("threads, no vector instructions;"), "{text}");
 }
 
 #[test]

@@ -849,11 +849,12 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
             .into(),
     };
     d.push(para(vec![text(format!(
-        "Wall-clock seconds measured on this machine with {} thread(s) (the recording's costs \
+        "Wall-clock seconds measured on this machine with {} thread(s){} (the recording's costs \
          record); the paper's are CPU seconds on one 2.66 GHz thread for 80 000 particles: \
          8580 | 8580, 0 | 551, 0 | 7619, 3900 | 6, totals 398 580 | 17 350 (speedup 23× for \
          100 τ, 650× per τ). Where each row comes from:",
-        t.threads
+        t.threads,
+        super::costs::vectors_clause(&t.vector_instructions)
     ))]));
     let pairing_note = if t.pairing_reused {
         "the pairing summary's seconds (the pairing was computed once and reused by this \

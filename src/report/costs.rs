@@ -41,6 +41,20 @@ pub struct CostTable {
     pub tau_extra: f64,
     /// Worker threads of the recording run.
     pub threads: usize,
+    /// Its engine's vector instructions (`avx512`, `avx2`, `scalar`; empty if not recorded).
+    pub vector_instructions: String,
+}
+
+/// `", AVX2 vectors"` and the like after a thread count, or nothing for a recording that
+/// does not say.
+pub fn vectors_clause(vector_instructions: &str) -> String {
+    match vector_instructions {
+        "" => String::new(),
+        "avx512" => ", AVX-512 vectors".into(),
+        "avx2" => ", AVX2 vectors".into(),
+        "scalar" => ", no vector instructions".into(),
+        other => format!(", {other} vectors"),
+    }
 }
 
 impl CostTable {
@@ -87,6 +101,7 @@ impl CostTable {
             tau_dem_source,
             tau_extra: extrapolation.seconds_per_period,
             threads: recording.threads,
+            vector_instructions: recording.vector_instructions.clone(),
         }
     }
 
@@ -158,6 +173,7 @@ mod tests {
             seconds_each_period: Vec::new(),
             stage_seconds: Default::default(),
             threads: 1,
+            vector_instructions: String::new(),
         };
         let extrapolation = ExtrapolationCosts {
             seconds_pairing: 0.0,
@@ -201,6 +217,7 @@ mod tests {
             seconds_each_period: vec![55.0; 4],
             stage_seconds: Default::default(),
             threads: 1,
+            vector_instructions: String::new(),
         };
         let extrapolation = ExtrapolationCosts {
             seconds_pairing: 2.0,
@@ -241,6 +258,7 @@ mod tests {
             seconds_each_period: Vec::new(),
             stage_seconds: Default::default(),
             threads: 2,
+            vector_instructions: String::new(),
         };
         let extrapolation = ExtrapolationCosts {
             seconds_pairing: 0.0,

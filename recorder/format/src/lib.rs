@@ -413,6 +413,11 @@ pub struct RecordingCosts {
     /// Per-stage DEM seconds over the whole run.
     pub stage_seconds: BTreeMap<String, f64>,
     pub threads: usize,
+    /// The vector instructions of the engine's hot loops (`avx512`, `avx2` or `scalar`),
+    /// which the times depend on as much as on `threads`; absent in recordings made before
+    /// 2026-11-29 and in imported ones.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub vector_instructions: String,
 }
 
 /// Whose fault an error is: the input the user gave (a file, a case, a flag: exit code 2)

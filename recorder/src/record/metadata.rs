@@ -118,7 +118,7 @@ pub struct Elapsed {
 
 impl Elapsed {
     /// The `tdex.costs` record of a run that took these times, with its engine's per-stage
-    /// seconds ([`stage_seconds`]) and the worker threads it ran on.
+    /// seconds ([`stage_seconds`]), the worker threads it ran on and the vector instructions.
     pub(crate) fn costs(&self, stage_seconds: BTreeMap<String, f64>) -> RecordingCosts {
         RecordingCosts {
             seconds_to_t0: self.to_t0,
@@ -134,6 +134,7 @@ impl Elapsed {
             },
             stage_seconds,
             threads: rayon::current_num_threads(),
+            vector_instructions: crate::simd::Simd::in_use().name().to_string(),
         }
     }
 }
