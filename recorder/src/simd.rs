@@ -48,12 +48,21 @@ impl Simd {
     pub fn requested() -> Result<Option<Simd>, SimdError> {
         match std::env::var(ENV) {
             Err(_) => Ok(None),
-            Ok(value) => match value.trim().to_ascii_lowercase().as_str() {
-                "avx512" | "avx-512" => Ok(Some(Simd::Avx512)),
-                "avx2" => Ok(Some(Simd::Avx2)),
-                "scalar" | "none" => Ok(Some(Simd::Scalar)),
-                _ => Err(SimdError { value }),
-            },
+            Ok(value) => Simd::cap(&value),
+        }
+    }
+
+    /// The cap a value of `TDEX_SIMD` names: none for an empty value (as if unset), any
+    /// case and surrounding spaces allowed.
+    pub fn cap(value: &str) -> Result<Option<Simd>, SimdError> {
+        match value.trim().to_ascii_lowercase().as_str() {
+            "" => Ok(None),
+            "avx512" | "avx-512" => Ok(Some(Simd::Avx512)),
+            "avx2" => Ok(Some(Simd::Avx2)),
+            "scalar" | "none" => Ok(Some(Simd::Scalar)),
+            _ => Err(SimdError {
+                value: value.to_string(),
+            }),
         }
     }
 
@@ -97,6 +106,19 @@ impl Simd {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cap_is_read_in_any_case_and_an_empty_one_is_no_cap() {
+        assert_eq!(Simd::cap(" AVX2 ").unwrap(), Some(Simd::Avx2));
+        assert_eq!(Simd::cap("avx-512").unwrap(), Some(Simd::Avx512));
+        assert_eq!(Simd::cap("Scalar").unwrap(), Some(Simd::Scalar));
+        assert_eq!(Simd::cap("").unwrap(), None);
+        let refused = Simd::cap("sse4").unwrap_err().to_string();
+        assert!(
+            refused.contains("TDEX_SIMD=\"sse4\"") && refused.contains("avx512, avx2 or scalar"),
+            "{refused}"
+        );
+    }
 
     #[test]
     fn the_set_in_use_is_one_this_cpu_has() {
