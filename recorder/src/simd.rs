@@ -7,8 +7,10 @@ use std::sync::OnceLock;
 /// The environment variable that caps the vector instructions.
 pub const ENV: &str = "TDEX_SIMD";
 
-/// A set of vector instructions the engine has a build of its hot loops for, narrowest first.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+/// A set of vector instructions the engine has a build of its hot loops for, narrowest first;
+/// serialised as its [`name`](Simd::name).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(into = "&'static str")]
 pub enum Simd {
     /// One double at a time (whatever the compiler makes of the baseline x86-64 or other CPU).
     Scalar,
@@ -100,6 +102,12 @@ impl Simd {
             Simd::Avx2 => "avx2",
             Simd::Avx512 => "avx512",
         }
+    }
+}
+
+impl From<Simd> for &'static str {
+    fn from(simd: Simd) -> Self {
+        simd.name()
     }
 }
 

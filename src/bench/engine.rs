@@ -24,7 +24,7 @@ struct EngineBench {
     steps: u64,
     threads: usize,
     /// The vector instructions of the engine's hot loops (`TDEX_SIMD` caps them).
-    vector_instructions: &'static str,
+    vector_instructions: recorder::simd::Simd,
     seconds: f64,
     particle_steps_per_s: f64,
     /// Wall time of each stage over the timed steps, and its share of the stages' sum.
@@ -106,7 +106,7 @@ fn time_tdex(plan: &BenchPlan) -> Result<(EngineBench, Option<PathBuf>)> {
         particles: n,
         steps: plan.steps,
         threads: plan.threads,
-        vector_instructions: recorder::simd::Simd::in_use().name(),
+        vector_instructions: recorder::simd::Simd::in_use(),
         seconds,
         particle_steps_per_s: per_step_particle / seconds,
         stages,
@@ -128,10 +128,7 @@ fn print_table(r: &EngineBench) {
         "{}: {} particles, {} steps after t0, {} threads",
         r.case, r.particles, r.steps, r.threads
     );
-    println!(
-        "vectors       {}",
-        recorder::simd::Simd::in_use().describe()
-    );
+    println!("vectors       {}", r.vector_instructions.describe());
     println!(
         "tdex          {:.3e} particle-steps/s ({:.2} s)",
         r.particle_steps_per_s, r.seconds

@@ -8,6 +8,7 @@
 //! Only `pair_batch::lanes_avx2`, reached once AVX2 is detected, makes values of this type;
 //! the module is private to the contact stage so that nothing else can.
 
+use super::pair_batch::Lane;
 use crate::math::Real;
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -15,12 +16,12 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 #[derive(Clone, Copy)]
 pub struct F64x4(__m256d);
 
-impl F64x4 {
-    pub const WIDTH: usize = 4;
+impl Lane for F64x4 {
+    const WIDTH: usize = 4;
 
     /// `a[0..4]`.
     #[inline(always)]
-    pub fn load(a: &[f64]) -> Self {
+    fn load(a: &[f64]) -> Self {
         let a = &a[..Self::WIDTH];
         // SAFETY: four doubles are in bounds; AVX is present (module docs)
         Self(unsafe { _mm256_loadu_pd(a.as_ptr()) })
@@ -28,7 +29,7 @@ impl F64x4 {
 
     /// Into `a[0..4]`.
     #[inline(always)]
-    pub fn store(self, a: &mut [f64]) {
+    fn store(self, a: &mut [f64]) {
         let a = &mut a[..Self::WIDTH];
         // SAFETY: as in `load`
         unsafe { _mm256_storeu_pd(a.as_mut_ptr(), self.0) }

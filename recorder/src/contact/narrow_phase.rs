@@ -4,8 +4,8 @@
 //! touched at the last step has history `k`, and a pair that has just touched gets a zero one.
 //!
 //! About one entry in three touches, in no pattern the branch predictor can learn, so the
-//! scan is worth doing without a branch per entry: on CPUs with AVX-512 (unless `TDEX_SIMD` caps it, `crate::simd`) eight entries are
-//! tested at once and their hits compressed into the batch. Both scans push the same pairs
+//! scan is worth doing without a branch per entry: when the batch runs with AVX-512
+//! (`crate::simd`) eight entries are tested at once and their hits compressed into the batch. Both scans push the same pairs
 //! in the same order (and compute the same bits), so the results do not depend on the CPU.
 
 use super::contact_sphere_sphere::overlapping;
@@ -41,8 +41,9 @@ pub fn scan(
 ) -> u64 {
     #[cfg(target_arch = "x86_64")]
     {
-        if crate::simd::Simd::in_use() == crate::simd::Simd::Avx512 {
-            // SAFETY: the engine uses AVX-512 only on a CPU with its F, VL and BW parts
+        if batch.simd() == crate::simd::Simd::Avx512 {
+            // SAFETY: a batch runs with AVX-512 only on a CPU with its F, VL and BW parts
+            // (`PairBatch::with_simd`)
             return unsafe { scan_avx512(entries, pos, radius, touching, batch, full) };
         }
     }

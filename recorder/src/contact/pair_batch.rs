@@ -237,6 +237,13 @@ impl PairBatch {
         }
     }
 
+    /// The instructions the batch's law runs with, one this CPU has: the scan that fills the
+    /// batch takes the same.
+    #[inline(always)]
+    pub fn simd(&self) -> Simd {
+        self.simd
+    }
+
     /// Contacts in the batch.
     #[inline(always)]
     pub fn len(&self) -> usize {
@@ -354,22 +361,25 @@ fn run_lanes(
     constants: &PairConstants,
 ) {
     macro_rules! with_model {
-        ($f:ident) => {
+        ($f:ident, $lane:ty) => {
             match constants.law.rolling_model {
-                RollingModel::Epsd2 => $f::<EPSD2>(lanes, delta, r2, n, constants),
-                RollingModel::Cdt => $f::<CDT>(lanes, delta, r2, n, constants),
-                RollingModel::Off => $f::<OFF>(lanes, delta, r2, n, constants),
+                RollingModel::Epsd2 => $f::<EPSD2, $lane>(lanes, delta, r2, n, constants),
+                RollingModel::Cdt => $f::<CDT, $lane>(lanes, delta, r2, n, constants),
+                RollingModel::Off => $f::<OFF, $lane>(lanes, delta, r2, n, constants),
             }
         };
     }
     match simd {
+        // the one-contact loop, which the compiler vectorises eight wide for AVX-512
         // SAFETY: a batch's `simd` is one the CPU has (`PairBatch::with_simd`)
         #[cfg(target_arch = "x86_64")]
-        Simd::Avx512 => unsafe { with_model!(lanes_avx512) },
+        Simd::Avx512 => unsafe { with_model!(lanes_avx512, f64) },
+        // four contacts per register: the compiler would leave the one-contact loop's AVX2
+        // build scalar (docs/benchmarks.md, "A host without AVX-512")
         // SAFETY: as above
         #[cfg(target_arch = "x86_64")]
-        Simd::Avx2 => unsafe { with_model!(lanes_avx2) },
-        _ => with_model!(lanes_scalar),
+        Simd::Avx2 => unsafe { with_model!(lanes_avx2, F64x4) },
+        _ => with_model!(law_lanes, f64),
     }
 }
 
@@ -377,73 +387,56 @@ const EPSD2: u8 = 0;
 const CDT: u8 = 1;
 const OFF: u8 = 2;
 
-/// One contact at a time: the compiler vectorises this loop where its cost model allows
-/// (AVX-512) and leaves it scalar elsewhere.
+/// What the lane loop runs on: `WIDTH` contacts' values, read from the start of a lane
+/// array's slice and written back there.
+pub(super) trait Lane: Real {
+    const WIDTH: usize;
+    fn load(a: &[f64]) -> Self;
+    fn store(self, a: &mut [f64]);
+}
+
+impl Lane for f64 {
+    const WIDTH: usize = 1;
+    #[inline(always)]
+    fn load(a: &[f64]) -> Self {
+        a[0]
+    }
+    #[inline(always)]
+    fn store(self, a: &mut [f64]) {
+        a[0] = self;
+    }
+}
+
+/// `law_lanes` compiled for a CPU feature (called only once the feature is detected).
+macro_rules! law_lanes_for {
+    ($name:ident, $feature:literal) => {
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = $feature)]
+        fn $name<const MODEL: u8, T: Lane>(
+            lanes: &mut Lanes,
+            delta: &[[f64; CAPACITY]; 3],
+            r2: &[f64; CAPACITY],
+            n: usize,
+            constants: &PairConstants,
+        ) {
+            law_lanes::<MODEL, T>(lanes, delta, r2, n, constants)
+        }
+    };
+}
+law_lanes_for!(lanes_avx512, "avx512f");
+law_lanes_for!(lanes_avx2, "avx2");
+
+/// The law for lanes `0..n`, `T::WIDTH` contacts at a time: the same functions a lone
+/// contact goes through, inlined into a loop without branches. The lanes from `n` up to the
+/// next multiple of the width are evaluated too, on whatever the arrays hold there, and
+/// never read.
 #[inline(always)]
-fn lanes_scalar<const MODEL: u8>(
+fn law_lanes<const MODEL: u8, T: Lane>(
     lanes: &mut Lanes,
     delta: &[[f64; CAPACITY]; 3],
     r2: &[f64; CAPACITY],
     n: usize,
     constants: &PairConstants,
-) {
-    let load = |a: &[f64]| a[0];
-    let store = |a: &mut [f64], x: f64| a[0] = x;
-    law_lanes::<MODEL, f64>(lanes, delta, r2, n, constants, 1, load, store)
-}
-
-/// The one-contact loop compiled for AVX-512, which the compiler vectorises eight wide.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-fn lanes_avx512<const MODEL: u8>(
-    lanes: &mut Lanes,
-    delta: &[[f64; CAPACITY]; 3],
-    r2: &[f64; CAPACITY],
-    n: usize,
-    constants: &PairConstants,
-) {
-    lanes_scalar::<MODEL>(lanes, delta, r2, n, constants)
-}
-
-/// Four contacts per [`F64x4`]: the compiler would leave the one-contact loop's AVX2 build
-/// scalar (docs/benchmarks.md, "A host without AVX-512").
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-fn lanes_avx2<const MODEL: u8>(
-    lanes: &mut Lanes,
-    delta: &[[f64; CAPACITY]; 3],
-    r2: &[f64; CAPACITY],
-    n: usize,
-    constants: &PairConstants,
-) {
-    let store = |a: &mut [f64], x: F64x4| x.store(a);
-    law_lanes::<MODEL, F64x4>(
-        lanes,
-        delta,
-        r2,
-        n,
-        constants,
-        F64x4::WIDTH,
-        F64x4::load,
-        store,
-    )
-}
-
-/// The law for lanes `0..n`, `width` contacts at a time in a `T` that `load` reads from the
-/// start of a lane array's slice and `store` writes there: the same functions a lone contact
-/// goes through, inlined into a loop without branches. The lanes from `n` up to the next
-/// multiple of `width` are evaluated too, on whatever the arrays hold there, and never read.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn law_lanes<const MODEL: u8, T: Real>(
-    lanes: &mut Lanes,
-    delta: &[[f64; CAPACITY]; 3],
-    r2: &[f64; CAPACITY],
-    n: usize,
-    constants: &PairConstants,
-    width: usize,
-    load: impl Fn(&[f64]) -> T,
-    store: impl Fn(&mut [f64], T),
 ) {
     let model = match MODEL {
         EPSD2 => RollingModel::Epsd2,
@@ -452,9 +445,9 @@ fn law_lanes<const MODEL: u8, T: Real>(
     };
     let PairConstants { law, heat, dt, .. } = *constants;
     let n = n.min(LANES);
-    for chunk in 0..n.div_ceil(width) {
-        let l = chunk * width;
-        let at = |a: &[f64]| load(&a[l..]);
+    for chunk in 0..n.div_ceil(T::WIDTH) {
+        let l = chunk * T::WIDTH;
+        let at = |a: &[f64]| T::load(&a[l..]);
         let at3 = |a: &[[f64; LANES]; 3]| [at(&a[0]), at(&a[1]), at(&a[2])];
         let si = SphereState {
             pos: [T::splat(0.0); 3], // the kinematics read only `delta`
@@ -487,13 +480,13 @@ fn law_lanes<const MODEL: u8, T: Real>(
             * heat.pair_area(c.distance, si.radius, sj.radius).sqrt();
         let heat_flow = conductance * at(&lanes.temp_diff);
         for a in 0..3 {
-            store(&mut lanes.shear[a][l..], history.shear[a]);
-            store(&mut lanes.roll[a][l..], history.roll[a]);
-            store(&mut lanes.force[a][l..], resp.force[a]);
-            store(&mut lanes.torque_i[a][l..], torque_i[a]);
-            store(&mut lanes.torque_j[a][l..], torque_j[a]);
+            history.shear[a].store(&mut lanes.shear[a][l..]);
+            history.roll[a].store(&mut lanes.roll[a][l..]);
+            resp.force[a].store(&mut lanes.force[a][l..]);
+            torque_i[a].store(&mut lanes.torque_i[a][l..]);
+            torque_j[a].store(&mut lanes.torque_j[a][l..]);
         }
-        store(&mut lanes.heat_flow[l..], heat_flow);
+        heat_flow.store(&mut lanes.heat_flow[l..]);
     }
 }
 
