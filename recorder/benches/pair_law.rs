@@ -5,16 +5,12 @@
 //! Run: `cargo bench -p recorder --bench pair_law` (`TDEX_CONTACTS`, default 4096 contacts;
 //! `TDEX_REPEAT`, default 400 passes over them; each build timed in turn, three rounds).
 
-use rand_xoshiro::rand_core::{Rng, SeedableRng};
-use rand_xoshiro::Xoshiro256PlusPlus;
-use recorder::case::{ConductionSpec, ContactArea, PairCoefficients, RollingModel};
-use recorder::contact::pair_batch::{PairBatch, PairConstants, SphereArrays};
-use recorder::contact::{ContactHistory, PairLaw};
-use recorder::heat::ConductionLaw;
+use recorder::case::{ContactArea, RollingModel};
+use recorder::contact::pair_batch::{PairBatch, PairConstants};
+use recorder::contact::pair_sample::{sample_heat, sample_law, PairSample};
+use recorder::contact::ContactHistory;
 use recorder::simd::Simd;
 use std::time::Instant;
-
-type Vec3 = [f64; 3];
 
 fn env_usize(name: &str, default: usize) -> usize {
     std::env::var(name)
@@ -23,69 +19,10 @@ fn env_usize(name: &str, default: usize) -> usize {
         .unwrap_or(default)
 }
 
-/// Touching pairs `2p, 2p + 1` with overlaps up to 5 % of a radius (as the unit test's).
-struct Contacts {
-    pos: Vec<Vec3>,
-    vel: Vec<Vec3>,
-    omega: Vec<Vec3>,
-    radius: Vec<f64>,
-    mass: Vec<f64>,
-    temp: Vec<f64>,
-    history: Vec<ContactHistory>,
-}
-
-fn contacts(count: usize) -> Contacts {
-    let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
-    let mut u = move || 2.0 * ((rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64) - 1.0;
-    let mut c = Contacts {
-        pos: vec![],
-        vel: vec![],
-        omega: vec![],
-        radius: vec![],
-        mass: vec![],
-        temp: vec![],
-        history: vec![],
-    };
-    for _ in 0..count {
-        let (ri, rj) = (0.005 * (1.0 + 0.2 * u()), 0.004 * (1.0 + 0.2 * u()));
-        let dir = [u(), u(), u()];
-        let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-        let gap = (ri + rj) * (1.0 - 0.025 * (1.0 + u()));
-        c.pos.extend([
-            [0.0; 3],
-            [gap * dir[0] / len, gap * dir[1] / len, gap * dir[2] / len],
-        ]);
-        c.vel.extend([
-            [0.5 * u(), 0.5 * u(), 0.5 * u()],
-            [0.5 * u(), 0.5 * u(), 0.5 * u()],
-        ]);
-        c.omega.extend([
-            [50.0 * u(), 50.0 * u(), 50.0 * u()],
-            [50.0 * u(), 50.0 * u(), 50.0 * u()],
-        ]);
-        c.radius.extend([ri, rj]);
-        c.mass
-            .extend([2500.0 * 4.19 * ri * ri * ri, 2500.0 * 4.19 * rj * rj * rj]);
-        c.temp.extend([20.0 + 10.0 * u(), 20.0 + 10.0 * u()]);
-        c.history.push(ContactHistory {
-            shear: [2e-4 * u(), 2e-4 * u(), 2e-4 * u()],
-            roll: [6e-6 * u(), 6e-6 * u(), 6e-6 * u()],
-        });
-    }
-    c
-}
-
 /// Every contact once through batches of `simd`; the advanced histories and the summed
 /// responses' bits (so that nothing is optimised away and builds can be compared).
-fn pass(simd: Simd, constants: &PairConstants, c: &Contacts, out: &mut [ContactHistory]) -> u64 {
-    let spheres = SphereArrays {
-        pos: &c.pos,
-        vel: &c.vel,
-        omega: &c.omega,
-        radius: &c.radius,
-        mass: &c.mass,
-        temp: &c.temp,
-    };
+fn pass(simd: Simd, constants: &PairConstants, c: &PairSample, out: &mut [ContactHistory]) -> u64 {
+    let spheres = c.spheres();
     let mut batch = PairBatch::with_simd(simd);
     let mut digest = 0u64;
     let mut evaluate = |batch: &mut PairBatch| {
@@ -111,18 +48,10 @@ fn pass(simd: Simd, constants: &PairConstants, c: &Contacts, out: &mut [ContactH
 fn main() {
     let count = env_usize("TDEX_CONTACTS", 4096);
     let repeat = env_usize("TDEX_REPEAT", 400);
-    let c = contacts(count);
-    let coefficients = PairCoefficients {
-        restitution: 0.2,
-        friction: 0.3,
-        rolling_friction: 0.002,
-    };
-    let law = PairLaw::new(1e7, 0.3, &coefficients, RollingModel::Epsd2);
-    let spec = ConductionSpec {
-        contact_area: ContactArea::Overlap,
-        youngs_modulus_real: Some(7e10),
-    };
-    let heat = ConductionLaw::new(&spec, 100.0, 100.0, 840.0, 1e7);
+    // the unit test's sample and constants (`recorder::contact::pair_sample`)
+    let c = PairSample::random(3, count);
+    let law = sample_law(RollingModel::Epsd2);
+    let heat = sample_heat(ContactArea::Overlap);
     let constants = PairConstants {
         law: &law,
         heat: &heat,

@@ -95,6 +95,22 @@ impl Simd {
         }
     }
 
+    /// A few words for after a thread count ("2 threads, AVX2 vectors").
+    pub fn vectors(self) -> &'static str {
+        match self {
+            Simd::Scalar => "no vector instructions",
+            Simd::Avx2 => "AVX2 vectors",
+            Simd::Avx512 => "AVX-512 vectors",
+        }
+    }
+
+    /// The set a recording's costs name (its [`name`](Simd::name), exactly), if any.
+    pub fn from_name(name: &str) -> Option<Simd> {
+        [Simd::Scalar, Simd::Avx2, Simd::Avx512]
+            .into_iter()
+            .find(|s| s.name() == name)
+    }
+
     /// The name `TDEX_SIMD` takes.
     pub fn name(self) -> &'static str {
         match self {
@@ -126,6 +142,15 @@ mod tests {
             refused.contains("TDEX_SIMD=\"sse4\"") && refused.contains("avx512, avx2 or scalar"),
             "{refused}"
         );
+    }
+
+    #[test]
+    fn every_set_is_found_by_its_name_and_only_by_it() {
+        for simd in [Simd::Scalar, Simd::Avx2, Simd::Avx512] {
+            assert_eq!(Simd::from_name(simd.name()), Some(simd));
+        }
+        assert_eq!(Simd::from_name("AVX2"), None);
+        assert_eq!(Simd::from_name(""), None);
     }
 
     #[test]

@@ -48,12 +48,12 @@ pub struct CostTable {
 /// `", AVX2 vectors"` and the like after a thread count, or nothing for a recording that
 /// does not say.
 pub fn vectors_clause(vector_instructions: &str) -> String {
-    match vector_instructions {
-        "" => String::new(),
-        "avx512" => ", AVX-512 vectors".into(),
-        "avx2" => ", AVX2 vectors".into(),
-        "scalar" => ", no vector instructions".into(),
-        other => format!(", {other} vectors"),
+    use recorder::simd::Simd;
+    match (vector_instructions, Simd::from_name(vector_instructions)) {
+        ("", _) => String::new(),
+        (_, Some(simd)) => format!(", {}", simd.vectors()),
+        // a name a later tdex may write: shown as it is
+        (other, None) => format!(", {other} vectors"),
     }
 }
 

@@ -7,6 +7,7 @@ mod f64x4;
 pub mod hertz_mindlin;
 pub mod narrow_phase;
 pub mod pair_batch;
+pub mod pair_sample;
 pub mod rolling;
 
 pub use hertz_mindlin::{ContactHistory, ContactKinematics, ContactResponse, PairLaw};

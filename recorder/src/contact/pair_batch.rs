@@ -493,73 +493,8 @@ fn law_lanes<const MODEL: u8, T: Lane>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case::{ConductionSpec, ContactArea, PairCoefficients};
-    use crate::insertion::uniform;
-    use rand_xoshiro::rand_core::SeedableRng;
-    use rand_xoshiro::Xoshiro256PlusPlus;
-
-    /// Random touching pairs of unequal spheres (pair `p` is spheres `2p`, `2p + 1`).
-    #[derive(Default)]
-    struct Sample {
-        pos: Vec<Vec3>,
-        vel: Vec<Vec3>,
-        omega: Vec<Vec3>,
-        radius: Vec<f64>,
-        mass: Vec<f64>,
-        temp: Vec<f64>,
-        history: Vec<ContactHistory>,
-    }
-
-    impl Sample {
-        fn spheres(&self) -> SphereArrays<'_> {
-            SphereArrays {
-                pos: &self.pos,
-                vel: &self.vel,
-                omega: &self.omega,
-                radius: &self.radius,
-                mass: &self.mass,
-                temp: &self.temp,
-            }
-        }
-    }
-
-    /// Overlaps up to 5 % of a radius, speeds and spins large enough that some contacts
-    /// slide and some rolling springs are capped.
-    fn contacts(seed: u64, count: usize) -> Sample {
-        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
-        let mut u = move || 2.0 * uniform(&mut rng) - 1.0;
-        let mut v3 = |s: f64| [s * u(), s * u(), s * u()];
-        let mut sample = Sample::default();
-        let Sample {
-            pos,
-            vel,
-            omega,
-            radius,
-            mass,
-            temp,
-            history: hist,
-        } = &mut sample;
-        for _ in 0..count {
-            let (ri, rj) = (
-                0.005 * (1.0 + 0.2 * v3(1.0)[0]),
-                0.004 * (1.0 + 0.2 * v3(1.0)[0]),
-            );
-            let dir = v3(1.0);
-            let n = scale(dir, 1.0 / norm2(dir).sqrt());
-            let gap = (ri + rj) * (1.0 - 0.025 * (1.0 + v3(1.0)[0]));
-            pos.extend([[0.0; 3], scale(n, gap)]);
-            vel.extend([v3(0.5), v3(0.5)]);
-            omega.extend([v3(50.0), v3(50.0)]);
-            radius.extend([ri, rj]);
-            mass.extend([2500.0 * 4.19 * ri * ri * ri, 2500.0 * 4.19 * rj * rj * rj]);
-            temp.extend([20.0 + 10.0 * v3(1.0)[0], 20.0 + 10.0 * v3(1.0)[0]]);
-            hist.push(ContactHistory {
-                shear: v3(2e-4),
-                roll: v3(6e-6),
-            });
-        }
-        sample
-    }
+    use crate::case::ContactArea;
+    use crate::contact::pair_sample::{sample_heat, sample_law, PairSample};
 
     #[test]
     fn a_batch_gives_every_contact_the_bits_it_gets_alone() {
@@ -571,19 +506,10 @@ mod tests {
     }
 
     fn batch_against_lone_contacts(simd: Simd) {
-        let coefficients = PairCoefficients {
-            restitution: 0.2,
-            friction: 0.3,
-            rolling_friction: 0.002,
-        };
         for model in [RollingModel::Epsd2, RollingModel::Cdt, RollingModel::Off] {
             for area in [ContactArea::Overlap, ContactArea::Hertz] {
-                let law = PairLaw::new(1e7, 0.3, &coefficients, model);
-                let spec = ConductionSpec {
-                    contact_area: area,
-                    youngs_modulus_real: Some(7e10),
-                };
-                let heat = ConductionLaw::new(&spec, 100.0, 100.0, 840.0, 1e7);
+                let law = sample_law(model);
+                let heat = sample_heat(area);
                 let constants = PairConstants {
                     law: &law,
                     heat: &heat,
@@ -591,7 +517,7 @@ mod tests {
                     uniform_pair: None,
                 };
                 // 37 pairs: two full batches and a part-filled one
-                let sample = contacts(7, 37);
+                let sample = PairSample::random(7, 37);
                 let spheres = sample.spheres();
                 let SphereArrays {
                     pos,
