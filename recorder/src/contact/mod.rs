@@ -2,8 +2,6 @@
 
 pub mod contact_sphere_sphere;
 pub mod contact_sphere_wall;
-#[cfg(target_arch = "x86_64")]
-mod f64x4;
 pub mod hertz_mindlin;
 pub mod narrow_phase;
 pub mod pair_batch;

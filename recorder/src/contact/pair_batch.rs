@@ -10,13 +10,18 @@
 //! depend on the width.
 
 use super::contact_sphere_sphere::{self as sphere_sphere, SphereState};
-#[cfg(target_arch = "x86_64")]
-use super::f64x4::F64x4;
 use super::{hertz_mindlin, ContactHistory, PairLaw};
 use crate::case::RollingModel;
 use crate::heat::ConductionLaw;
 use crate::math::*;
 use crate::simd::Simd;
+#[cfg(target_arch = "x86_64")]
+use f64x4::F64x4;
+
+// private to this stage: only its AVX2 build makes these values, once the CPU is known to
+// have AVX (`PairBatch::with_simd`)
+#[cfg(target_arch = "x86_64")]
+mod f64x4;
 
 /// Contacts evaluated together: two AVX-512 vectors of doubles.
 pub const LANES: usize = 16;

@@ -6,9 +6,10 @@
 //! approximate root), so a lane's result has the bits of the lone contact's.
 //!
 //! Only `pair_batch::lanes_avx2`, reached once AVX2 is detected, makes values of this type;
-//! the module is private to the contact stage so that nothing else can.
+//! the module is private to `pair_batch`, so no other code can name the type (the law's
+//! generic functions get it from there as their `T`).
 
-use super::pair_batch::Lane;
+use super::Lane;
 use crate::math::Real;
 use std::arch::x86_64::*;
 use std::ops::{Add, Div, Mul, Neg, Sub};
