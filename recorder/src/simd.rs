@@ -29,6 +29,9 @@ pub struct SimdError {
 }
 
 impl Simd {
+    /// Every set, narrowest first.
+    pub const ALL: [Simd; 3] = [Simd::Scalar, Simd::Avx2, Simd::Avx512];
+
     /// The widest set this CPU has.
     pub fn detected() -> Simd {
         #[cfg(target_arch = "x86_64")]
@@ -81,9 +84,7 @@ impl Simd {
     /// Every set this CPU can run, narrowest first (the tests check each against the others).
     pub fn available() -> impl Iterator<Item = Simd> {
         let widest = Simd::detected();
-        [Simd::Scalar, Simd::Avx2, Simd::Avx512]
-            .into_iter()
-            .filter(move |&s| s <= widest)
+        Simd::ALL.into_iter().filter(move |&s| s <= widest)
     }
 
     /// Plain words for a user.
@@ -106,9 +107,7 @@ impl Simd {
 
     /// The set a recording's costs name (its [`name`](Simd::name), exactly), if any.
     pub fn from_name(name: &str) -> Option<Simd> {
-        [Simd::Scalar, Simd::Avx2, Simd::Avx512]
-            .into_iter()
-            .find(|s| s.name() == name)
+        Simd::ALL.into_iter().find(|s| s.name() == name)
     }
 
     /// The name `TDEX_SIMD` takes.
@@ -146,7 +145,7 @@ mod tests {
 
     #[test]
     fn every_set_is_found_by_its_name_and_only_by_it() {
-        for simd in [Simd::Scalar, Simd::Avx2, Simd::Avx512] {
+        for simd in Simd::ALL {
             assert_eq!(Simd::from_name(simd.name()), Some(simd));
         }
         assert_eq!(Simd::from_name("AVX2"), None);
