@@ -168,10 +168,10 @@ pub fn write_with(
             ))
         }
         (None, _) => Err(format!(
-            "{rec_path} has no costs record (its writer was interrupted)"
+            "{rec_path} has no costs record (written with --reproducible, which leaves out the wall times)"
         )),
         (_, None) => Err(format!(
-            "{extra_path} has no costs record (its writer was interrupted)"
+            "{extra_path} has no costs record (written with --reproducible, which leaves out the wall times)"
         )),
     };
 

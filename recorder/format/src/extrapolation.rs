@@ -366,7 +366,7 @@ impl ExtrapolationReader {
         &self.info
     }
 
-    /// What the extrapolation cost (absent only if the writer was interrupted).
+    /// What the extrapolation cost (absent in a reproducible extrapolation).
     pub fn costs(&self) -> Option<&ExtrapolationCosts> {
         self.costs.as_ref()
     }
