@@ -119,7 +119,8 @@ pub fn symmetry_words(symmetry: Symmetry) -> Option<&'static str> {
 /// called unsafe: measured, 1.01 on `heated_drum` and 0.99 on `small_drum`, where the mirror
 /// helped, 0.98–1.03 over the starts of `heated_drum` with 2 to 8 recorded periods, where
 /// it helped or did no harm, and 1.39 on `axial_drum`, where it made the extrapolation far
-/// worse (docs/validation.md, "The mirror image"). A judgement from these cases.
+/// worse (docs/validation.md#long-horizons-100-periods-and-more). A judgement from these
+/// cases.
 const MIRROR_LONGER_AT_MOST: f64 = 1.1;
 
 /// The mirror checks of a path in plain words: one line per start, and the verdict on the

@@ -1,6 +1,6 @@
 //! `tdex inspect` on an extrapolation (its pairing, scheme and heat balance), its suggested
 //! `n` that `--n` accepts, its histogram's tail said out loud; and the small messages a new
-//! user trips over (issue 22): a missing file named once, temperatures in kelvin.
+//! user trips over: a missing file named once, temperatures in kelvin.
 
 use crate::cli_compare::record_and_extrapolate;
 use crate::cli_record::write_foreign_mcap;

@@ -280,8 +280,8 @@ fn extrapolate(rec: &Path, out: &Path, periods: &str, extra: &[&str]) -> serde_j
     serde_json::from_str(&tdex_ok(&args)).unwrap()
 }
 
-/// Issue 23's replay end to end on a real recording of three periods: through the recorded
-/// stretch the extrapolation is the recording's own continuation (the DEM's positions at t2
+/// The replay of several recorded periods, end to end on a real recording of three: through
+/// the recorded stretch the extrapolation is the recording's own continuation (the DEM's positions at t2
 /// and t3, and the temperatures of tables 2 and 3 applied in order to the DEM's t1, to the
 /// bit); then it jumps. Its first period alone is the paper's method on a recording of one
 /// period; the path is a function of the seed; `tdex pair` stores one pairing per start.

@@ -1,7 +1,7 @@
-//! `tdex report` end to end on the tiny drum (issue 5, must-show 3): the SVGs are valid XML
-//! with drawn elements, every Markdown link resolves, the HTML references the plots, the
-//! tables hold numbers, and the same inputs give the same bytes. Without a DEM reference
-//! (issue 22) the report is the prediction alone, over every extrapolated period.
+//! `tdex report` end to end on the tiny drum: the SVGs are valid XML with drawn elements,
+//! every Markdown link resolves, the HTML references the plots, the tables hold numbers, and
+//! the same inputs give the same bytes. Without a DEM reference the report is the prediction
+//! alone, over every extrapolated period.
 
 use crate::cli_run::TINY_CASE;
 use crate::util::*;

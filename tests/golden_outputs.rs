@@ -2,11 +2,11 @@
 //! (recordings of one period with reference periods, a twin, a heated mantle and another
 //! sampling; pairing sidecars; an extrapolation with each scheme, streamed and in memory;
 //! compare and inspect JSON, all `--reproducible`) and `tests/golden/SHA256` holds their
-//! sums as tdex wrote them when several recorded periods were added (issue 23): a recording
-//! of one period, and everything made from it, must stay the paper's method to the byte.
+//! sums as tdex wrote them before several recorded periods were added: a recording of one
+//! period, and everything made from it, must stay the paper's method to the byte.
 //! A deliberate change of a format regenerates the list (`bash tests/golden/run.sh
 //! target/release/tdex DIR && cp DIR/SHA256 tests/golden/SHA256`) and says why in its
-//! commit (docs/architecture.md, "the byte-identity check").
+//! commit (docs/architecture.md#byte-identity-of-the-refactoring).
 
 use crate::util::{repo, tdex};
 use std::process::Command;

@@ -1,5 +1,5 @@
-//! Pairing of the t0/t1 snapshots and replay of a recorded collision table (docs/method.md §5–6;
-//! issue 4): [`pairing`] finds the roles, [`replay`] applies the table period after period,
+//! Pairing of the t0/t1 snapshots and replay of a recorded collision table (docs/method.md
+//! §5–6): [`pairing`] finds the roles, [`replay`] applies the table period after period,
 //! [`path`] chooses the recorded period each period replays (several recorded periods),
 //! [`sidecar`] stores the pairing beside the recording and [`cache`] reuses it;
 //! [`extrapolate_recording`] extrapolates a recording with them.

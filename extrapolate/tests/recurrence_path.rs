@@ -1,4 +1,4 @@
-//! Several recorded periods replayed along a recurrence path (issue 23), on synthetic
+//! Several recorded periods replayed along a recurrence path, on synthetic
 //! recordings written with `RecordingWriter`: the identity through the recorded stretch, the
 //! path's seed, heat over 500 periods, `P' = 1` as the paper's method, the refusal of
 //! `P' > P`, streamed against in memory; the axial mirror's images and pairings.

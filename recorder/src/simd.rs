@@ -1,6 +1,6 @@
 //! Which vector instructions the engine's hot loops use: the widest this CPU has, or narrower
-//! ones when `TDEX_SIMD` asks (to see a smaller CPU's speed here, or to compare the builds in
-//! one session). Every build computes the same bits, so the choice changes the speed only.
+//! ones when `TDEX_SIMD` asks (to see a smaller CPU's speed here, or to compare the builds on
+//! one machine). Every build computes the same bits, so the choice changes the speed only.
 
 use std::sync::OnceLock;
 

@@ -7,7 +7,7 @@ use serde::Serialize;
 use std::time::Instant;
 use tdex_format::RecordingReader;
 
-/// Targets of issue 3: recording at most 1.15× a plain run, at most 6 bytes per row.
+/// Design targets: recording at most 1.15× a plain run, at most 6 bytes per row.
 const MAX_OVERHEAD: f64 = 1.15;
 const MAX_BYTES_PER_ROW: f64 = 6.0;
 

@@ -493,7 +493,7 @@ pub enum StudyCommand {
     /// regime (Mellmann 2001), the dynamic angle of repose, the active-layer thickness and
     /// (where particles move relative to the drum) the extrapolation error and speedup.
     Regimes(RegimesStudyArgs),
-    /// Long-horizon study (issue 23): per number of recorded periods P, the extrapolation
+    /// Long-horizon study: per number of recorded periods P, the extrapolation
     /// over the reference periods against the DEM and its twins (median ratio to their
     /// spread, the t_k outside their range) beside what recording P periods costs. CASE may
     /// also be a recording made with `tdex record --recorded-periods P --reference K --twins M`

@@ -1,4 +1,4 @@
-//! What an extrapolation predicts, from its file alone (issue 22): at every `t_k` of all its
+//! What an extrapolation predicts, from its file alone: at every `t_k` of all its
 //! periods, the bed mean, the hot and cold group means, the temperature spread, the heat
 //! content (whose change is what the walls gave) and the mixing of the hot and cold labels.
 //! The same measures on DEM snapshots (the reference and its twins) overlay the prediction

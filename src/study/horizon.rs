@@ -1,5 +1,5 @@
 //! `tdex study horizon`: the extrapolation over many periods against the DEM and its twins,
-//! per number of recorded periods P, beside what recording P periods costs (issue 23), so
+//! per number of recorded periods P, beside what recording P periods costs, so
 //! that a user can pick P for their case.
 //!
 //! The DEM runs once and records the largest P (or a recording made before is read): a

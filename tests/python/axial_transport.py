@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """How much does one revolution's axial transport differ from the DEM's usual one?
-(diagnostic, docs/validation.md, "Where the pilot drum's excess is")
+(diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: axial_transport.py RECORDING.mcap BIN_D   (RECORDING made with --reference K; the
        drum's axis is y; BIN_D: the axial bins' width in particle diameters)

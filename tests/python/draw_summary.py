@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The small_drum draws of docs/validation.md ("The same draws with three twins, on four beds"),
+"""The small_drum draws of docs/validation.md#the-extrapolation-at-short-horizons,
 summarised: per method, the medians of ratio_to_floor over the six t_k after each start, their
 mean, standard error and count at most 1; the paired differences of two recorded revolutions
 against one from the same start; and a rank comparison with a genuine DEM run judged in the

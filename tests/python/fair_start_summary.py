@@ -1,6 +1,5 @@
 #!/usr/bin/env python3
-"""Draws from t2 judged against twins that part at t2 (docs/validation.md, "Twins that part
-where the extrapolation starts"). (diagnostic)
+"""Draws from t2 judged against twins that part at t2 (docs/validation.md#the-extrapolation-at-short-horizons). (diagnostic)
 
 usage: fair_start_summary.py DIR BED [BED ...]
        DIR holds, for every BED (a seed), `tdex compare --json` outputs of the recording fBED.mcap

@@ -1,6 +1,5 @@
 #!/usr/bin/env python3
-"""Half-revolution periods on small_drum (docs/validation.md, "One and a half revolutions of
-variety"): does a third recorded half revolution bring one revolution's draws to two's? (diagnostic)
+"""Half-revolution periods on small_drum (docs/validation.md#the-extrapolation-at-short-horizons): does a third recorded half revolution bring one revolution's draws to two's? (diagnostic)
 
 usage: halves_summary.py DIR BED [BED ...]
        DIR holds, for every BED (a seed), the recording hBED.mcap (`--tau-rev 0.5

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Where the long-horizon excess comes from (diagnostic, docs/validation.md, "100 periods").
+"""Where the long-horizon excess comes from (diagnostic, docs/validation.md#long-horizons-100-periods-and-more).
 
 usage:
   horizon_diagnostics.py jumps COMPARE.json INSPECT.json

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Markdown tables of a long-horizon comparison (docs/validation.md, "100 periods").
+"""Markdown tables of a long-horizon comparison (docs/validation.md#long-horizons-100-periods-and-more).
 
     python3 tests/python/horizon_table.py CAPACITY K1,K2,... LABEL=compare.json [...]
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """The Lacey mixing index of the initially hot and cold particles over time, for the DEM,
-its twins and an extrapolation (diagnostic, docs/validation.md, "100 periods").
+its twins and an extrapolation (diagnostic, docs/validation.md#long-horizons-100-periods-and-more).
 
 usage: lacey.py RECORDING.mcap EXTRA.mcap K [K ...]   (RECORDING made with --twins)
 

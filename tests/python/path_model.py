@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Which replay path through a recording's periods (the sub-periods of one revolution, or whole
 revolutions) keeps the slabs' tilts as a DEM run does? A model without conduction
-(diagnostic, docs/validation.md, "Why the tilts stray").
+(diagnostic, docs/validation.md#long-horizons-100-periods-and-more).
 
 usage: path_model.py REFERENCE.mcap RECORDING.mcap [EXTRA.mcap ...]
        REFERENCE: the run recorded with one period and --reference K --twins 1 or more;

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """In which plane does an extrapolation's large-scale excess lie? (diagnostic,
-docs/validation.md, "Where the pilot drum's excess is")
+docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: plane_distance.py RECORDING.mcap EXTRA.mcap EDGE_D   (RECORDING made with --reference
        K --twins M; the drum's axis is y; EDGE_D: the cells' edge in particle diameters)

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Where in the bed is an extrapolation's excess distance to the DEM? (diagnostic,
-docs/validation.md, "100 periods")
+docs/validation.md#long-horizons-100-periods-and-more)
 
 usage: radial_profile.py RECORDING.mcap EXTRA.mcap K [K ...]
        (RECORDING made with --reference and --twins; the drum's axis is y)

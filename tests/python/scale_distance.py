@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """At which length scale does an extrapolation depart from the DEM more than the DEM runs
-depart from each other? (diagnostic, docs/validation.md, "Where the pilot drum's excess is")
+depart from each other? (diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: scale_distance.py RECORDING.mcap EXTRA.mcap [EDGE_D ...]
        (RECORDING made with --reference K, and --twins M for the DEM runs' distances;

@@ -1,6 +1,5 @@
 #!/usr/bin/env python3
-"""How far apart is the same particle in two runs? (diagnostic, docs/validation.md, "Where
-the pilot drum's excess is")
+"""How far apart is the same particle in two runs? (diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: separation.py RECORDING.mcap EXTRA.mcap   (RECORDING made with --reference K, and
        --twins M for the twins' figures)

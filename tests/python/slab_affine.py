@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Does the replay's excess in the slabs' tilts come from repeating the recorded revolution's
-map of each slab's cross-section? (diagnostic, docs/validation.md, "Why the tilts stray")
+map of each slab's cross-section? (diagnostic, docs/validation.md#long-horizons-100-periods-and-more)
 
 usage: slab_affine.py RECORDING.mcap EXTRA.mcap [SLAB_D [CELL_D]]
        (RECORDING made with --reference K --twins M and one recorded period; EXTRA its

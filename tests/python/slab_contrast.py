@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Does the hot-cold contrast vary along the axis more in the extrapolation than in the DEM?
-(diagnostic, docs/validation.md, "Where the pilot drum's excess is")
+(diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: slab_contrast.py RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with --reference
        K --twins M; the drum's axis is y; SLAB_D: the slabs' width in particle diameters)

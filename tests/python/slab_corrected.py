@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """How much of an extrapolation's excess over the DEM runs' spread do the axial slabs' hot and
-cold means carry, and how much the tilt of each slab's field across the drum? (diagnostic, docs/validation.md, "Where the pilot drum's excess is")
+cold means carry, and how much the tilt of each slab's field across the drum? (diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: slab_corrected.py RECORDING.mcap EXTRA.mcap SLAB_D EDGE_D
        (RECORDING made with --reference K --twins M; the drum's axis is y; SLAB_D: the axial

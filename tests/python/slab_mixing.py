@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """How fast does each axial slab mix at the particle scale, in the DEM runs and in the
-replay? (diagnostic, docs/validation.md, "Where the pilot drum's excess is"; needs scipy)
+replay? (diagnostic, docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6; needs scipy)
 
 usage: slab_mixing.py RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with --reference K
        [--twins M]; the drum's axis is y; SLAB_D: the slabs' width in particle diameters)

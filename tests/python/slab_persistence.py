@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Do the axial slabs keep their own mixing rate from one revolution to the next? (diagnostic,
-docs/validation.md, "Where the pilot drum's excess is")
+docs/validation.md#the-papers-drum-at-80-000-particles-tables-5-and-6)
 
 usage: slab_persistence.py [--each] RECORDING.mcap EXTRA.mcap SLAB_D   (RECORDING made with
        --reference K [--twins M]; the drum's axis is y; SLAB_D: the slabs' width in particle

@@ -437,7 +437,7 @@ pub(crate) fn mean_cheapest_sampled(
 const AXIAL_WINDOW: usize = 64;
 
 /// The one-dimensional transport along the bed's long axis, an estimate of the
-/// large-scale part of the pairing (docs/pairing.md, "Long drums").
+/// large-scale part of the pairing (docs/pairing.md#long-drums).
 ///
 /// In a long drum the particles drift along the axis, and the count of particles on
 /// either side of a cross-section differs between t0 and t1 by hundreds: the optimal
@@ -601,8 +601,8 @@ impl Graph {
     /// of their column indices (largest less smallest) and of the number of distinct
     /// 64-byte lines their columns occupy in an array of 8 bytes per column (the
     /// auction's potentials). A bid or a Dijkstra scan waits on those lines, so the
-    /// renumbering (`order.rs`) is judged by them (docs/benchmarks.md, "Pairing the
-    /// long kiln: cubic Morton cells").
+    /// renumbering (`order.rs`) is judged by them
+    /// (docs/benchmarks.md#what-each-accepted-change-bought).
     pub(crate) fn locality(&self) -> (f64, f64) {
         let (span, lines) = (0..self.rows())
             .into_par_iter()

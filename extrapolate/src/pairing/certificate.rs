@@ -38,7 +38,7 @@ pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree (at most 64: a leaf's hits are the bits of a
 /// `u64`, [`WeightedTree::leaf_hits`]). 32 until the leaves' test lost its branches;
 /// since then 64 visits fewer nodes for the same points found, 8 % less time in the
-/// certificate on the long kiln (docs/benchmarks.md, eighteenth session).
+/// certificate on the long kiln (docs/benchmarks.md#what-each-accepted-change-bought).
 const LEAF: usize = 64;
 const _: () = assert!(LEAF <= 64);
 /// Relative safety margin on `R_p` and the bounds: floating-point distances and the
@@ -200,7 +200,7 @@ impl WeightedTree {
     /// The points of one leaf (tree positions `leaf`, at most 64) with `d + W < r`, as the
     /// bits of their offsets in the leaf. Without branches, so that the compiler runs it
     /// on vector registers: the certificate's passes spend 13 % less time than with a test
-    /// and a call per point (docs/benchmarks.md, eighteenth session).
+    /// and a call per point (docs/benchmarks.md#what-each-accepted-change-bought).
     fn leaf_hits(&self, leaf: std::ops::Range<usize>, p: &[f64; 3], r: f64) -> u64 {
         let [xs, ys, zs] = self.axes.each_ref().map(|a| &a[leaf.clone()]);
         let ws = &self.w[leaf];
@@ -305,7 +305,8 @@ pub(crate) struct Check {
     /// c − u − v < slack`), at most `per_row` per row, the tightest first; sorted. Added
     /// to the graph with the violations, they cannot become violations when a repair
     /// solve raises their row's `u` by less than their margin: on the long kiln one exact
-    /// round fewer (docs/benchmarks.md, nineteenth session). Empty with a slack of 0.
+    /// round fewer (docs/benchmarks.md#what-each-accepted-change-bought). Empty with a
+    /// slack of 0.
     pub(crate) close: Vec<(u32, u32)>,
     /// How many pairs were tested exactly (work counter).
     pub(crate) examined: u64,
@@ -366,7 +367,7 @@ pub(crate) struct Memo {
     /// At most this many violating pairs, and as many close ones, per row are returned
     /// (at least 1). One cap for both: on the long kiln caps of 4, 8, 16 and 32 changed
     /// the exact rounds' work by a few per cent and the pairing's time not measurably
-    /// (docs/benchmarks.md, twentieth session).
+    /// (docs/benchmarks.md#tried-and-not-kept).
     per_row: usize,
 }
 

@@ -42,7 +42,7 @@ pub struct PairingOptions {
     /// Length of one integer cost unit, in the units of the coordinates. Pair costs are
     /// `round(distance / unit)`: `unit = diameter · 1e-6` resolves distances to a
     /// millionth of a particle diameter, far below any physical meaning, while keeping
-    /// costs small integers (≈ 6·10⁸ for the length of the paper's drum).
+    /// costs small integers (≈ 6·10⁸ for the length of the long kiln).
     pub unit: f64,
     /// Number of nearest t0 candidates per t1 point (≥ 1); multiplied by 4/3 on a bed
     /// with a large transport along its long axis (docs/pairing.md). If they admit no perfect
@@ -75,7 +75,7 @@ impl PairingOptions {
     /// [`PairingOptions::for_diameter`] for these snapshots: the unit is a millionth of a
     /// diameter, or, on a bed whose joint bounding box is more than 4 294 diameters
     /// across, that diagonal over `0.999 · (2³² − 1)`, so that every pair cost fits the
-    /// solver's 32-bit edge costs (docs/pairing.md, "Integer costs"). Non-finite
+    /// solver's 32-bit edge costs (docs/pairing.md#integer-costs). Non-finite
     /// coordinates leave the unit as it is; [`pair`] reports them.
     #[must_use]
     pub fn for_bed(diameter: f64, x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Self {
@@ -313,12 +313,12 @@ const AUCTION_ROUNDS: usize = 2;
 const AUCTION_REFINE: i64 = 16;
 
 /// The auctions that follow those certificate searches start at the initial ε divided by
-/// this (2¹² units, 0.004 diameters, on the beds of issue 24), below the pause: the rows
-/// a new edge undercuts by more than that are freed and bid in finer phases, where
-/// resuming at the pause ε re-ran its coarse phase over the whole bed. On the long kiln
-/// 6.2·10⁶ bids instead of 8.2·10⁶, on the pilot drum 3.5·10⁶ instead of 4.3·10⁶ and 2
-/// exact rounds instead of 3; the same pairings (docs/benchmarks.md, "Pairing the long
-/// kiln: resuming the auction finer").
+/// this (2¹² units, 0.004 diameters, on the long kiln and the pilot drum), below the
+/// pause: the rows a new edge undercuts by more than that are freed and bid in finer
+/// phases, where resuming at the pause ε re-ran its coarse phase over the whole bed. On
+/// the long kiln 6.2·10⁶ bids instead of 8.2·10⁶, on the pilot drum 3.5·10⁶ instead of
+/// 4.3·10⁶ and 2 exact rounds instead of 3; the same pairings
+/// (docs/benchmarks.md#what-each-accepted-change-bought).
 const AUCTION_RESUME: i64 = 256;
 
 /// The certificate searches on the auction's potentials return up to this many
@@ -327,7 +327,7 @@ const AUCTION_RESUME: i64 = 256;
 /// violated otherwise surface again, one round at a time, in the exact phase: with 8
 /// its solves scanned 1.04·10⁶ columns in 6 rounds, with 32 0.37·10⁶ in 5 (with 32 in
 /// every pass too: 4 rounds, no faster). The pilot drum's counts do not change
-/// (docs/benchmarks.md, "Pairing the long kiln: resuming the auction finer").
+/// (docs/benchmarks.md#what-each-accepted-change-bought).
 const AUCTION_PAIRS_PER_ROW: usize = 32;
 
 /// `TDEX_PAIR_TRACE` set: phase timings and counters of the sparse solver on stderr
@@ -410,14 +410,14 @@ fn sparse(
     trace!(t, "morton order + grid, n {n}");
 
     // Candidates and warm-start potentials follow the transport along the bed's long
-    // axis (`candidates::Axial`; docs/pairing.md, "Long drums").
+    // axis (`candidates::Axial`; docs/pairing.md#long-drums).
     let axial = candidates::Axial::new(x0, x1);
     let centres = axial.centres(x1);
     let shift = axial.mean_abs_shift();
     trace!(t, "axial transport and centres");
     // A bed with a large axial transport needs more candidates: the long kiln has no
     // perfect matching at k = 24, and finding that out costs the auction's whole budget
-    // (docs/pairing.md, "Long drums"). The test is `shift > ρ`, ρ the mean cheapest
+    // (docs/pairing.md#long-drums). The test is `shift > ρ`, ρ the mean cheapest
     // candidate cost of the k-graph, estimated on every `AXIAL_SAMPLE`-th row so that
     // the graph is built once, with the k it needs (building the k = 24 graph only to
     // throw it away cost 0.3 s on the long kiln). ρ itself is then taken on the whole
@@ -541,9 +541,9 @@ fn sparse(
     // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
     // redone: exit edges (the growth step below) are long, and their potentials make
     // the certificate expensive. A real bed whose t1 shape differs slightly from t0's
-    // has no perfect matching at k = 12 or 16, the paper's drum none at k = 24
+    // has no perfect matching at k = 12 or 16, the long kiln none at k = 24
     // (docs/pairing.md). Checking up front instead costs 1.1–1.3 s of Hopcroft–Karp
-    // on the paper's drum, feasible or not (its augmenting paths are long).
+    // on the long kiln, feasible or not (its augmenting paths are long).
     if lap.col_of_row.contains(&sparse_lap::NONE) && k0 < n {
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {

@@ -1,6 +1,6 @@
 //! Warm start of a long bed by axial slabs: the auction run on square sub-problems cut
 //! across the bed's long axis, in parallel, their prices then joined into one global
-//! ε-complementary-slackness state (docs/pairing.md, "Long drums: axial slabs").
+//! ε-complementary-slackness state (docs/pairing.md#axial-slabs).
 //!
 //! On a long drum with an axial transport the global auction's price war runs along the
 //! whole bed: every row takes part in carrying the transport from one end to the other,

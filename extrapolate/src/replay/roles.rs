@@ -10,7 +10,7 @@ use super::{move_each_to_roles, ReplayError};
 pub struct RoleTemperatures {
     /// `[T, 1/C]` of each role. Measured on the 80 000-particle long kiln (AMD EPYC), the
     /// explicit loop over these pairs is faster than over two arrays of 8-byte values even
-    /// when it reads no `1/C` at all (docs/benchmarks.md, "Temperatures beside 1/C").
+    /// when it reads no `1/C` at all (docs/benchmarks.md#what-each-accepted-change-bought).
     pub(super) roles: Vec<[f64; 2]>,
 }
 

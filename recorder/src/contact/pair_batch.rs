@@ -380,7 +380,7 @@ fn run_lanes(
         #[cfg(target_arch = "x86_64")]
         Simd::Avx512 => unsafe { with_model!(lanes_avx512, f64) },
         // four contacts per register: the compiler would leave the one-contact loop's AVX2
-        // build scalar (docs/benchmarks.md, "A host without AVX-512")
+        // build scalar (docs/benchmarks.md#the-dem-engine-against-liggghts-38)
         // SAFETY: as above
         #[cfg(target_arch = "x86_64")]
         Simd::Avx2 => unsafe { with_model!(lanes_avx2, F64x4) },
