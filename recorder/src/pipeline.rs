@@ -262,16 +262,16 @@ pub fn contact_interactions_in_chunks(
             }
             _ => Prefetch::default(),
         };
-        let owners = slots.len().max(1) as f64;
+        let holders = slots.len().max(1) as f64;
         let pair_entries = OLD_HISTORIES.with_borrow_mut(|old| {
             old.clear();
             old.extend_from_slice(&h[..touched]);
             old.push(ContactHistory::default());
             let mut batch = PairBatch::default();
-            // the owner's sums are kept apart and added once its contacts are done, as
+            // the holder's sums are kept apart and added once its contacts are done, as
             // each pair's partner sums are added in pair order: the order of every sum
             // is fixed by the list alone
-            let mut owner = Owner::default();
+            let mut holder = Holder::default();
             let entries = ListEntries {
                 slots,
                 offsets,
@@ -281,14 +281,14 @@ pub fn contact_interactions_in_chunks(
             };
             let mut evaluate = |batch: &mut PairBatch| {
                 batch.evaluate(&constants, &spheres, old, h);
-                owner.scatter(batch, &mut sums, first_slot);
-                next.advance(owner.slots_done(first_slot) as f64 / owners);
+                holder.scatter(batch, &mut sums, first_slot);
+                next.advance(holder.slots_done(first_slot) as f64 / holders);
             };
             let touching_pairs =
                 narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
             // the batch holds fewer than a full batch's contacts now: one evaluation
             evaluate(&mut batch);
-            owner.add_to(&mut sums, first_slot);
+            holder.add_to(&mut sums, first_slot);
             touching_pairs
         });
         let finished = finished_slots(l, layer_start);
@@ -369,20 +369,20 @@ fn finished_slots(l: usize, layer_start: &[u32]) -> Range<usize> {
 }
 
 /// The sums of the particle whose contacts the pair stage is handing out.
-struct Owner {
+struct Holder {
     slot: usize,
     force: Vec3,
     torque: Vec3,
     heat_flow: f64,
 }
 
-impl Default for Owner {
+impl Default for Holder {
     fn default() -> Self {
         Self::new(usize::MAX)
     }
 }
 
-impl Owner {
+impl Holder {
     fn new(slot: usize) -> Self {
         Self {
             slot,
@@ -392,7 +392,7 @@ impl Owner {
         }
     }
 
-    /// Adds an evaluated batch's responses to the owners' and partners' sums of a task's
+    /// Adds an evaluated batch's responses to the holders' and partners' sums of a task's
     /// pieces starting at `first_slot`, and empties the batch.
     #[inline(always)]
     fn scatter(&mut self, batch: &mut PairBatch, sums: &mut Sums, first_slot: usize) {
@@ -400,10 +400,10 @@ impl Owner {
             let (i, j, r) = batch.response(l);
             if i != self.slot {
                 self.add_to(sums, first_slot);
-                *self = Owner::new(i);
+                *self = Holder::new(i);
             }
             self.force = add(self.force, r.force);
-            self.torque = add(self.torque, r.torque_owner);
+            self.torque = add(self.torque, r.torque_holder);
             self.heat_flow += r.heat_flow;
             let jl = j - first_slot;
             sums.force[jl] = sub(sums.force[jl], r.force);
@@ -413,8 +413,8 @@ impl Owner {
         batch.consume();
     }
 
-    /// Slots of a task starting at `first_slot` that its batches have reached, the owner's
-    /// included (0 before the first owner): the task's progress.
+    /// Slots of a task starting at `first_slot` that its batches have reached, the holder's
+    /// included (0 before the first holder): the task's progress.
     fn slots_done(&self, first_slot: usize) -> usize {
         if self.slot == usize::MAX {
             return 0;
@@ -422,7 +422,7 @@ impl Owner {
         self.slot + 1 - first_slot
     }
 
-    /// Adds the sums to the owner's slot of a task's pieces starting at `first_slot`.
+    /// Adds the sums to the holder's slot of a task's pieces starting at `first_slot`.
     fn add_to(&self, sums: &mut Sums, first_slot: usize) {
         if self.slot == usize::MAX {
             return;

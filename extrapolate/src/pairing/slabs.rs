@@ -80,13 +80,13 @@ impl Slabs {
 /// What a slab's auction leaves, by axial rank from the slab's first rank (its solve
 /// covers its own ranks and the overlap on either side): the rows' partners (ranks in
 /// the same frame, `NONE` if free), their matched costs, the columns' potentials and
-/// owners.
+/// holders.
 struct SlabState {
     lo: usize,
     col_of_row: Vec<u32>,
     mcost: Vec<i64>,
     v: Vec<i64>,
-    owner: Vec<u32>,
+    holder: Vec<u32>,
     bids: u64,
 }
 
@@ -141,14 +141,14 @@ pub(crate) fn warm_start(
                 col_of_row: lap.col_of_row.clone(),
                 mcost: lap.mcost.clone(),
                 v: (0..m).map(|c| lap.v(c)).collect(),
-                owner: lap.row_of_col_vec(),
+                holder: lap.row_of_col_vec(),
                 bids,
             }
         })
         .collect();
 
     // Every rank r belongs to slab `home(r)`; its row's partner and its column's
-    // potential and owner come from that slab's solve.
+    // potential and holder come from that slab's solve.
     let home = |r: usize| {
         let s = slabs.of_rank(r);
         debug_assert!(start(s) <= r && r < start(s + 1));
@@ -168,8 +168,8 @@ pub(crate) fn warm_start(
         let rc = st.lo + c as usize; // the partner's rank
         let other = &states[home(rc)];
         // The partner's own slab must agree (it always does inside one slab).
-        let owner = other.owner[rc - other.lo];
-        if owner != NONE && owner as usize + other.lo == r {
+        let holder = other.holder[rc - other.lo];
+        if holder != NONE && holder as usize + other.lo == r {
             col_of_row[s1[r] as usize] = s0[rc];
             mcost[s1[r] as usize] = st.mcost[r - st.lo];
         }

@@ -185,7 +185,7 @@ impl Lap {
     /// above the row's best `c − v`: after a smaller ε, or after edges were added), then
     /// lets every free row bid for its best column `j1`: `v[j1]` drops by `w2 − w1 + ε`
     /// (`w1`, `w2`: best and second best `c − v`), the row takes `j1` within ε of its
-    /// best, and the previous owner is freed and bids next. A phase ends when every
+    /// best, and the previous holder is freed and bids next. A phase ends when every
     /// row is matched; ε then shrinks by `theta`, down to `eps_min`. `v` only decreases,
     /// so `max v <= 0` still holds. The auction stops early, leaving a consistent
     /// partial matching, after `budget` bids in total or once a potential falls below
@@ -201,20 +201,20 @@ impl Lap {
         eps_min: i64,
         budget: u64,
     ) -> u64 {
-        // Dense copies of the potentials and owners: the bids touch nothing else, and
+        // Dense copies of the potentials and holders: the bids touch nothing else, and
         // 8 + 4 bytes per column stay in cache where the 40-byte `Col` would not.
         let mut v: Vec<i64> = self.cols.iter().map(|c| c.v).collect();
-        let mut owner: Vec<u32> = self.cols.iter().map(|c| c.row).collect();
+        let mut holder: Vec<u32> = self.cols.iter().map(|c| c.row).collect();
         let bids = auction_phases(
             g,
             &mut v,
-            &mut owner,
+            &mut holder,
             &mut self.col_of_row,
             &mut self.mcost,
             [eps0, theta, eps_min],
             budget,
         );
-        for ((c, v), r) in self.cols.iter_mut().zip(v).zip(owner) {
+        for ((c, v), r) in self.cols.iter_mut().zip(v).zip(holder) {
             c.v = v;
             c.row = r;
         }
@@ -402,7 +402,7 @@ impl Lap {
 fn auction_phases(
     g: &Graph,
     v: &mut [i64],
-    owner: &mut [u32],
+    holder: &mut [u32],
     col_of_row: &mut [u32],
     mcost: &mut [i64],
     [eps0, theta, eps_min]: [i64; 3],
@@ -435,7 +435,7 @@ fn auction_phases(
             .collect();
         for p in violating {
             let q0 = std::mem::replace(&mut col_of_row[p as usize], NONE);
-            owner[q0 as usize] = NONE;
+            holder[q0 as usize] = NONE;
         }
         stack.clear();
         stack.extend(
@@ -472,8 +472,8 @@ fn auction_phases(
             bids += 1;
             let j = j1 as usize;
             v[j] -= w2 - w1 + eps;
-            let prev = owner[j];
-            owner[j] = i as u32;
+            let prev = holder[j];
+            holder[j] = i as u32;
             col_of_row[i] = j1;
             mcost[i] = c1;
             if prev != NONE {

@@ -40,12 +40,12 @@ pub struct SphereArrays<'a> {
     pub temp: &'a [f64],
 }
 
-/// What the law gives each contact of a batch: the force on the owner (the partner gets its
-/// negative), both torques, and the heat flow into the owner.
+/// What the law gives each contact of a batch: the force on the holder (the partner gets its
+/// negative), both torques, and the heat flow into the holder.
 #[derive(Debug, Clone, Copy)]
 pub struct PairResponse {
     pub force: Vec3,
-    pub torque_owner: Vec3,
+    pub torque_holder: Vec3,
     pub torque_partner: Vec3,
     pub heat_flow: f64,
 }
@@ -61,7 +61,7 @@ pub struct PairBatch {
     /// Contacts evaluated since the batch was made: the next evaluated contact's history
     /// goes to this index of the new histories.
     evaluated: usize,
-    owner: [u32; CAPACITY],
+    holder: [u32; CAPACITY],
     partner: [u32; CAPACITY],
     /// Index of the pair's history before this step in the old histories handed to
     /// `evaluate` (a pair that has just touched points at a zero history).
@@ -107,7 +107,7 @@ impl PairBatch {
             len: 0,
             ready: 0,
             evaluated: 0,
-            owner: [0; CAPACITY],
+            holder: [0; CAPACITY],
             partner: [0; CAPACITY],
             old: [0; CAPACITY],
             delta: [[0.0; CAPACITY]; 3],
@@ -144,12 +144,19 @@ pub struct PairConstants<'a> {
 }
 
 impl PairBatch {
-    /// Adds the touching pair `(owner, partner)` whose centres are `delta` apart (`r2` its
+    /// Adds the touching pair `(holder, partner)` whose centres are `delta` apart (`r2` its
     /// squared length) and whose history was `old`; true when the batch is full.
     #[inline(always)]
-    pub fn push(&mut self, owner: usize, partner: usize, old: usize, delta: Vec3, r2: f64) -> bool {
+    pub fn push(
+        &mut self,
+        holder: usize,
+        partner: usize,
+        old: usize,
+        delta: Vec3,
+        r2: f64,
+    ) -> bool {
         let l = self.len;
-        self.owner[l] = owner as u32;
+        self.holder[l] = holder as u32;
         self.partner[l] = partner as u32;
         self.old[l] = old as u32;
         for (d, &x) in self.delta.iter_mut().zip(&delta) {
@@ -160,7 +167,7 @@ impl PairBatch {
         self.len >= LANES
     }
 
-    /// Adds the lanes of `hit` among 8 entries of `owner` (partner slots, old history
+    /// Adds the lanes of `hit` among 8 entries of `holder` (partner slots, old history
     /// indices, centre distances `delta` and their squared lengths `r2`), keeping their
     /// order; true when the batch is full. The batch must not be full before.
     ///
@@ -175,7 +182,7 @@ impl PairBatch {
     pub fn push_lanes(
         &mut self,
         hit: std::arch::x86_64::__mmask8,
-        owner: usize,
+        holder: usize,
         partner: std::arch::x86_64::__m256i,
         old: std::arch::x86_64::__m256i,
         delta: [std::arch::x86_64::__m512d; 3],
@@ -189,7 +196,7 @@ impl PairBatch {
         // SAFETY: l + 8 <= CAPACITY, so each store stays inside its array
         unsafe {
             let stored = |a: &mut [u32; CAPACITY]| a.as_mut_ptr().add(l) as *mut __m256i;
-            _mm256_storeu_si256(stored(&mut self.owner), _mm256_set1_epi32(owner as i32));
+            _mm256_storeu_si256(stored(&mut self.holder), _mm256_set1_epi32(holder as i32));
             _mm256_storeu_si256(
                 stored(&mut self.partner),
                 _mm256_maskz_compress_epi32(hit, partner),
@@ -266,26 +273,26 @@ impl PairBatch {
         self.len == 0
     }
 
-    /// Owner slot, partner slot and response of the `l`-th contact pushed.
+    /// Holder slot, partner slot and response of the `l`-th contact pushed.
     #[inline(always)]
     pub fn response(&self, l: usize) -> (usize, usize, PairResponse) {
         let lanes = &self.lanes;
         let response = PairResponse {
             force: lane3(&lanes.force, l),
-            torque_owner: lane3(&lanes.torque_i, l),
+            torque_holder: lane3(&lanes.torque_i, l),
             torque_partner: lane3(&lanes.torque_j, l),
             heat_flow: lanes.heat_flow[l],
         };
-        (self.owner[l] as usize, self.partner[l] as usize, response)
+        (self.holder[l] as usize, self.partner[l] as usize, response)
     }
 
-    /// Owner, partner, old history index, `delta` and `r2` of the `l`-th contact pushed.
+    /// Holder, partner, old history index, `delta` and `r2` of the `l`-th contact pushed.
     #[cfg(test)]
     pub(crate) fn pushed(&self, l: usize) -> (u32, u32, u32, Vec3, f64) {
         assert!(l < self.len);
         let delta = lane3(&self.delta, l);
         (
-            self.owner[l],
+            self.holder[l],
             self.partner[l],
             self.old[l],
             delta,
@@ -304,7 +311,7 @@ impl PairBatch {
         assert!(ready <= len);
         if len > ready {
             let rest = ready..len;
-            self.owner.copy_within(rest.clone(), 0);
+            self.holder.copy_within(rest.clone(), 0);
             self.partner.copy_within(rest.clone(), 0);
             self.old.copy_within(rest.clone(), 0);
             for d in &mut self.delta {
@@ -327,7 +334,7 @@ impl PairBatch {
     ) {
         let lanes = &mut self.lanes;
         for l in 0..n {
-            let (i, j) = (self.owner[l] as usize, self.partner[l] as usize);
+            let (i, j) = (self.holder[l] as usize, self.partner[l] as usize);
             let h = &old[self.old[l] as usize];
             for a in 0..3 {
                 lanes.vel_i[a][l] = spheres.vel[i][a];
@@ -575,7 +582,7 @@ mod tests {
                         bits(resp.force),
                         "{simd:?} {model:?} pair {p}"
                     );
-                    assert_eq!(bits(r.torque_owner), bits(resp.torque_on_i(c.lever_i)));
+                    assert_eq!(bits(r.torque_holder), bits(resp.torque_on_i(c.lever_i)));
                     assert_eq!(
                         bits(r.torque_partner),
                         bits(resp.torque_on_partner(c.lever_j))

@@ -21,9 +21,9 @@ const BLOCK: usize = 512;
 pub struct NeighborList {
     /// Entries of slot `i` are `offsets[i]..offsets[i + 1]`.
     pub offsets: Vec<u32>,
-    /// Partner slots, each greater than the owner's slot and in its layer or the next.
+    /// Partner slots, each greater than the holder's slot and in its layer or the next.
     pub neighbors: Vec<u32>,
-    /// Histories of the touching entries, seen from the owner, packed layer by layer: layer
+    /// Histories of the touching entries, seen from the holder, packed layer by layer: layer
     /// `l`'s in entry order from its first entry `offsets[layer_start[l]]` on (the rest of
     /// its range is unused). Most entries lie within the skin without touching, so the pair
     /// stage streams the contacts' histories, not one per entry.
@@ -60,20 +60,20 @@ pub struct NeighborList {
     carried: Carried,
 }
 
-/// Open contacts carried through a rebuild, grouped by the permanent id of their owner.
+/// Open contacts carried through a rebuild, grouped by the permanent id of their holder.
 #[derive(Debug, Clone, Default)]
 struct Carried {
     /// Contacts of id `a` are `start[a]..start[a + 1]`.
     start: Vec<u32>,
     /// Where the next contact of each id goes while they are collected.
     next: Vec<u32>,
-    /// Partner id (walls: particle count + wall index) and history seen from the owner.
+    /// Partner id (walls: particle count + wall index) and history seen from the holder.
     contacts: Vec<(u32, ContactHistory)>,
 }
 
 impl Carried {
-    fn find(&self, owner: u32, partner: u32) -> Option<ContactHistory> {
-        let range = self.start[owner as usize] as usize..self.start[owner as usize + 1] as usize;
+    fn find(&self, holder: u32, partner: u32) -> Option<ContactHistory> {
+        let range = self.start[holder as usize] as usize..self.start[holder as usize + 1] as usize;
         self.contacts[range]
             .iter()
             .find(|(p, _)| *p == partner)
@@ -116,7 +116,7 @@ impl NeighborList {
         by_entry
     }
 
-    /// Collects the open contacts (pairs and walls) by owner id into `self.carried`.
+    /// Collects the open contacts (pairs and walls) by holder id into `self.carried`.
     fn carry_open_contacts(&mut self, ids: &[u32]) {
         let n = ids.len();
         let slots = self.offsets.len().saturating_sub(1);
@@ -142,7 +142,7 @@ impl NeighborList {
         }
         contacts.clear();
         contacts.resize(start[n] as usize, (0, ContactHistory::default()));
-        // each owner's pairs first, then its walls
+        // each holder's pairs first, then its walls
         next.clear();
         next.extend_from_slice(start);
         self.for_each_touching(|i, e, &h| {
@@ -318,7 +318,7 @@ impl NeighborList {
 
     /// Checks a list read back from a checkpoint against `n` particles, the grid's `layers`
     /// and `walls` walls: every index the stages follow stays in range, and every partner
-    /// lies after its owner in the owner's layer or the next (what the parallel pair stage
+    /// lies after its holder in the holder's layer or the next (what the parallel pair stage
     /// relies on).
     pub fn check(&self, n: usize, layers: usize, walls: usize) -> Result<(), String> {
         if self.offsets.is_empty() && self.wall_offsets.is_empty() && self.layer_start.is_empty() {
