@@ -19,6 +19,10 @@ struct ImportSummary {
     contact_frames: u64,
     contact_frames_skipped: u64,
     atom_frames_skipped: u64,
+    /// Wall contact frames sampled (`null` for adiabatic walls).
+    wall_frames: Option<u64>,
+    /// Particle samples that touched the mantle through several of its facets, merged.
+    wall_contacts_merged: u64,
     rows: u64,
     file_bytes: u64,
     table_bytes: u64,
@@ -37,12 +41,22 @@ pub fn run(plan: &ImportPlan) -> Result<()> {
     .map_err(|e| {
         let advice = match e {
             ImportError::NoAtomDumpAtT1 { .. } => " (give --tau / --tau-rev for the period dumped)",
+            ImportError::HeatedMantleWithoutWallDumps { .. } => {
+                " (give --wall-contacts with the dumps of `compute wall/gran/local id contactArea`, \
+                 or import with a case without drum.wall_temperature)"
+            }
+            ImportError::WallDumpsWithoutHeatedMantle { .. } => {
+                " (set drum.wall_temperature to the mantle's `temperature` in the deck, or leave \
+                 out --wall-contacts)"
+            }
             _ => "",
         };
         let (atoms, contacts) = (&plan.dumps.atoms, &plan.dumps.contacts);
-        anyhow::Error::new(e).context(format!(
-            "importing the LIGGGHTS dumps {atoms} and {contacts}{advice}"
-        ))
+        let dumps = match &plan.dumps.walls {
+            Some(walls) => format!("{atoms}, {contacts} and {}", walls.pattern),
+            None => format!("{atoms} and {contacts}"),
+        };
+        anyhow::Error::new(e).context(format!("importing the LIGGGHTS dumps {dumps}{advice}"))
     })?;
     let reader = RecordingReader::open(&plan.output)?;
     let summary = ImportSummary {
@@ -54,6 +68,8 @@ pub fn run(plan: &ImportPlan) -> Result<()> {
         contact_frames: report.contact_frames,
         contact_frames_skipped: report.contact_frames_skipped,
         atom_frames_skipped: report.atom_frames_skipped,
+        wall_frames: report.wall_frames,
+        wall_contacts_merged: report.wall_contacts_merged,
         rows: report.summary.rows,
         file_bytes: reader.file_bytes(),
         table_bytes: reader.table_bytes(),
@@ -79,6 +95,21 @@ pub fn run(plan: &ImportPlan) -> Result<()> {
         s.reference_periods,
         summary.atom_frames_skipped
     );
+    if let Some(frames) = summary.wall_frames {
+        println!(
+            "mantle        {frames} wall contact frames sampled; {}",
+            match summary.wall_contacts_merged {
+                0 => "one contact per particle and sample (the mantle's facets count as one \
+                      surface)"
+                    .to_string(),
+                m => format!(
+                    "{m} particle samples touched several facets at once (LIGGGHTS's default \
+                     curvature): each is one wall row with the facets' summed conductance, as \
+                     LIGGGHTS conducted"
+                ),
+            }
+        );
+    }
     println!(
         "table         {} rows, {:.2} bytes per row, file {:.1} MB",
         summary.rows,

@@ -10,11 +10,11 @@ use std::path::{Path, PathBuf};
 use tdex_format::RecordingReader;
 
 /// LIGGGHTS timestep of t0 in the hand-written dumps; τ = 30 steps, n = 10.
-const T0: u64 = 1000;
-const ATOMS: usize = 250;
+pub(crate) const T0: u64 = 1000;
+pub(crate) const ATOMS: usize = 250;
 
 /// One particle of a hand-written atom frame: (LIGGGHTS id, position, temperature).
-fn particle(id: usize, step: u64) -> (usize, [f64; 3], f64) {
+pub(crate) fn particle(id: usize, step: u64) -> (usize, [f64; 3], f64) {
     let k = id as f64;
     let shift = (step - T0) as f64 * 1e-5;
     (
@@ -79,7 +79,7 @@ const ATOM_STEPS: [u64; 4] = [T0, T0 + 15, T0 + 30, T0 + 60];
 
 /// Hand-written dumps in `dir`: one atom file per timestep and one contact file with every
 /// frame from t0 to t0 + 40.
-fn write_dumps(dir: &Path) {
+pub(crate) fn write_dumps(dir: &Path) {
     for step in ATOM_STEPS {
         std::fs::write(
             dir.join(format!("dump_atoms.{step}")),
@@ -273,13 +273,13 @@ fn assert_refused(damage: impl FnOnce(&Path), file: &str, line: u64, expect: &st
     assert!(!out.exists(), "no recording may be written");
 }
 
-fn edit(path: &Path, f: impl FnOnce(String) -> String) {
+pub(crate) fn edit(path: &Path, f: impl FnOnce(String) -> String) {
     let text = std::fs::read_to_string(path).unwrap();
     std::fs::write(path, f(text)).unwrap();
 }
 
 /// Replaces `from` by `to` in line `line` (1-based) of `path`.
-fn edit_line(path: &Path, line: usize, from: &str, to: &str) {
+pub(crate) fn edit_line(path: &Path, line: usize, from: &str, to: &str) {
     edit(path, |t| {
         t.lines()
             .enumerate()

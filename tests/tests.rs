@@ -10,6 +10,7 @@ mod cli_compare;
 mod cli_export;
 mod cli_extrapolate;
 mod cli_import;
+mod cli_import_walls;
 mod cli_inspect;
 mod cli_outputs;
 mod cli_record;

@@ -427,6 +427,14 @@ pub struct LiggghtsArgs {
     /// The contact dump files (`dump local`), as --atoms.
     #[arg(long)]
     pub contacts: String,
+    /// For a heated mantle (`drum.wall_temperature`): the wall contact dump files
+    /// (`compute wall/gran/local id contactArea` through `dump local`), as --atoms.
+    #[arg(long)]
+    pub wall_contacts: Option<String>,
+    /// The mantle's mesh id in the wall contact dumps: its place (0-based) in `fix wall/gran
+    /// ... meshes`; the drum's other mesh is the adiabatic end caps.
+    #[arg(long, default_value_t = 0, requires = "wall_contacts", value_parser = clap::value_parser!(u32).range(0..2))]
+    pub mantle_mesh: u32,
     /// The case file describing the run (time step, materials, conduction, drum).
     #[arg(long)]
     pub case: PathBuf,

@@ -489,6 +489,12 @@ impl ImportPlan {
             dumps: recorder::import::liggghts::Dumps {
                 atoms: args.atoms,
                 contacts: args.contacts,
+                walls: args
+                    .wall_contacts
+                    .map(|pattern| recorder::import::liggghts::WallDumps {
+                        pattern,
+                        mantle_mesh: args.mantle_mesh,
+                    }),
             },
             case_path: args.case,
             case_toml,

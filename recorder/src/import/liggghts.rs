@@ -1,7 +1,8 @@
 //! `tdex import liggghts`: a recording built from LIGGGHTS text dumps — the atoms at `t0`,
 //! `t1` and every later `t_k` (`dump custom`), the contacts every `n` steps of the period
-//! (`compute pair/gran/local` through `dump local`) — by the same sampler and writer as
-//! `tdex record`, so that it extrapolates exactly like a recording tdex made itself.
+//! (`compute pair/gran/local` through `dump local`) and, for a heated mantle, the wall
+//! contacts (`compute wall/gran/local`) — by the same sampler and writer as `tdex record`,
+//! so that it extrapolates exactly like a recording tdex made itself.
 
 use super::dump::{DumpSet, FramePart, Items};
 use super::ImportError;
@@ -18,7 +19,22 @@ use tdex_format::{RecordingCosts, RecordingSummary, RecordingWriter, Snapshot};
 pub struct Dumps {
     pub atoms: String,
     pub contacts: String,
+    /// The wall contacts of a heated mantle; `None` for adiabatic walls.
+    pub walls: Option<WallDumps>,
 }
+
+/// The wall contact dumps of a heated mantle (`compute wall/gran/local id contactArea`
+/// through `dump local`) and which of the wall fix's meshes is the mantle.
+#[derive(Debug, Clone)]
+pub struct WallDumps {
+    pub pattern: String,
+    /// The mantle's place in `fix wall/gran ... meshes` (0-based, as LIGGGHTS writes the
+    /// mesh id); the drum's other mesh holds the adiabatic end caps.
+    pub mantle_mesh: u32,
+}
+
+/// Meshes a drum's wall fix may list: the mantle and the end caps.
+pub const DRUM_MESHES: u32 = 2;
 
 /// What an import read and wrote.
 #[derive(Debug, Clone)]
@@ -34,6 +50,11 @@ pub struct ImportReport {
     pub contact_frames_skipped: u64,
     /// Atom frames passed over (not at a `t0 + kτ`).
     pub atom_frames_skipped: u64,
+    /// For a heated mantle: the wall contact frames sampled, and the particle samples that
+    /// touched the mantle through several of its facets at once (LIGGGHTS's default
+    /// `curvature`), merged into one wall row with the facets' summed `sqrt(a)`.
+    pub wall_frames: Option<u64>,
+    pub wall_contacts_merged: u64,
 }
 
 /// Imports the dumps as a recording of one period `τ = opts.period_steps` sampled every
@@ -48,11 +69,30 @@ pub fn import(
     opts: &RecordOptions,
     dest: &Path,
 ) -> Result<ImportReport, ImportError> {
-    if case.drum.wall_temperature.is_some() {
+    match (case.drum.wall_temperature, &dumps.walls) {
+        (Some(temperature), None) => {
+            return Err(ImportError::HeatedMantleWithoutWallDumps {
+                case: case_path.to_path_buf(),
+                temperature,
+            })
+        }
+        (None, Some(walls)) => {
+            return Err(ImportError::WallDumpsWithoutHeatedMantle {
+                case: case_path.to_path_buf(),
+                pattern: walls.pattern.clone(),
+            })
+        }
+        _ => {}
+    }
+    if let Some(w) = dumps
+        .walls
+        .as_ref()
+        .filter(|w| w.mantle_mesh >= DRUM_MESHES)
+    {
         return Err(ImportError::Case(format!(
-            "{}: drum.wall_temperature is set, but LIGGGHTS wall contacts are not imported: \
-             only adiabatic walls (no wall rows in the table) can be imported",
-            case_path.display()
+            "the mantle's mesh id {} is not one of the drum's {DRUM_MESHES} meshes (0, 1: \
+             their places in `fix wall/gran ... meshes`)",
+            w.mantle_mesh
         )));
     }
     let mut sampler =
@@ -80,13 +120,12 @@ pub fn import(
         EndCaps::Rotating => WallMotion::Rotating,
         EndCaps::Fixed => WallMotion::Fixed,
     };
+    let mut walls = WallSet::drum(case.drum.radius, case.drum.length, motion);
+    walls.mantle_temperature = case.drum.wall_temperature;
     let run = RunAtT0 {
         particles,
         r_max: t0.radius.iter().cloned().fold(0.0, f64::max),
-        walls: wall_infos(
-            &WallSet::drum(case.drum.radius, case.drum.length, motion),
-            particles,
-        ),
+        walls: wall_infos(&walls, particles),
         t0: atoms.step_t0 as f64 * case.time.dt,
         step_t0: atoms.step_t0,
     };
@@ -109,7 +148,9 @@ pub fn import(
         law: ConductionLaw::new(
             &case.conduction,
             case.material.conductivity,
-            case.material.conductivity,
+            case.drum
+                .wall_conductivity
+                .unwrap_or(case.material.conductivity),
             case.material.heat_capacity,
             case.material.youngs_modulus,
         ),
@@ -117,52 +158,39 @@ pub fn import(
     let (step_t0, every) = (atoms.step_t0, opts.sample_every as u64);
     // no overflow: the atom dumps hold t1 = t0 + τ, a timestep ≤ dump::MAX_TIMESTEP
     let step_t1 = step_t0 + opts.period_steps;
-    let mut set = DumpSet::open(&dumps.contacts, Items::Entries)?;
-    let (mut sampled, mut skipped) = (0u64, 0u64);
-    let mut last: Option<(u64, PathBuf)> = None;
+    let grid = SampleGrid {
+        step_t0,
+        step_t1,
+        every,
+    };
+    let mut pair_frames = SampledFrames::open(&dumps.contacts, "contact")?;
+    let mut wall_frames = match &dumps.walls {
+        Some(w) => Some((
+            SampledFrames::open(&w.pattern, "wall contact")?,
+            WallContacts {
+                contacts: &contacts,
+                mantle_mesh: w.mantle_mesh,
+            },
+        )),
+        None => None,
+    };
     // the contacts dumped at the end of step S are those its forces and conduction used
     // (velocity Verlet computes them on the positions x(S)): sample k = S − t0 − n stands
     // for steps k … k + n − 1 of the period, so the samples are the dumps t0 + n … t1
-    let mut expected = step_t0 + every;
-    let mut pairs = Vec::new();
-    while expected <= step_t1 {
-        let next = set.next_timestep();
-        match next {
-            Some(s) if s < expected || (s - step_t0) % every != 0 => {
-                let (_, parts) = set.read_next(true)?.expect("a frame is next");
-                last = parts.first().map(|p| (s, p.path.clone()));
-                skipped += 1;
-            }
-            Some(s) if s == expected => {
-                let (_, parts) = set.read_next(false)?.expect("a frame is next");
-                contacts.sample(&parts, &mut pairs)?;
-                sampler.sample(s - step_t0 - every, pairs.iter().copied());
-                writer.push_rows(sampler.drain_ready())?;
-                last = parts.first().map(|p| (s, p.path.clone()));
-                sampled += 1;
-                expected += every;
-            }
-            _ => {
-                // a damaged or misordered frame further on is the more precise error
-                while set.read_next(true)?.is_some() {}
-                let found = match (next, &last) {
-                    (Some(s), _) => format!("the next contact dump is at timestep {s}"),
-                    (None, Some((s, path))) => {
-                        format!("the contact dumps end at timestep {s} ({})", path.display())
-                    }
-                    (None, None) => "no contact dump follows t0".into(),
-                };
-                return Err(ImportError::Inconsistent(format!(
-                    "{}: no contact dump at timestep {expected} (t0 = {step_t0} + {} steps): the \
-                     period τ = {} steps from t0 needs one every n = {every} steps from t0 + n to \
-                     t1 = {step_t1}, and {found}; dump the contacts every n steps (or give --n \
-                     as a multiple of their spacing) for the whole period",
-                    dumps.contacts,
-                    expected - step_t0,
-                    opts.period_steps
-                )));
-            }
+    let (mut pairs, mut walls, mut merged) = (Vec::new(), Vec::new(), 0u64);
+    for s in (step_t0 + every..=step_t1).step_by(every as usize) {
+        let parts = pair_frames.frame_at(s, &grid, opts.period_steps)?;
+        contacts.sample(&parts, &mut pairs)?;
+        if let Some((frames, wall)) = &mut wall_frames {
+            let parts = frames.frame_at(s, &grid, opts.period_steps)?;
+            merged += wall.sample(&parts, &mut walls)?;
+            // rows that start at one sample keep the order of (i, j), walls after pairs
+            // of the same particle: j = particles + wall
+            pairs.extend_from_slice(&walls);
+            pairs.sort_by_key(|&(i, j, _)| (i, j));
         }
+        sampler.sample(s - step_t0 - every, pairs.iter().copied());
+        writer.push_rows(sampler.drain_ready())?;
     }
     writer.push_rows(sampler.finish())?;
     for snapshot in &atoms.snapshots[1..] {
@@ -176,10 +204,92 @@ pub fn import(
         step_t0,
         step_t1,
         reference_periods,
-        contact_frames: sampled,
-        contact_frames_skipped: skipped,
+        contact_frames: pair_frames.sampled,
+        contact_frames_skipped: pair_frames.skipped,
         atom_frames_skipped: atoms.skipped,
+        wall_frames: wall_frames.map(|(frames, _)| frames.sampled),
+        wall_contacts_merged: merged,
     })
+}
+
+/// The timesteps a period's samples are dumped at: `t0 + n, t0 + 2n, …, t1`.
+struct SampleGrid {
+    step_t0: u64,
+    step_t1: u64,
+    every: u64,
+}
+
+/// One kind of `dump local` frames (contacts or wall contacts), read in step with the
+/// samples: frames between samples or outside the period are passed over.
+struct SampledFrames {
+    set: DumpSet,
+    pattern: String,
+    /// What the frames hold, for the messages (`contact`, `wall contact`).
+    what: &'static str,
+    sampled: u64,
+    skipped: u64,
+    last: Option<(u64, PathBuf)>,
+}
+
+impl SampledFrames {
+    fn open(pattern: &str, what: &'static str) -> Result<Self, ImportError> {
+        Ok(Self {
+            set: DumpSet::open(pattern, Items::Entries)?,
+            pattern: pattern.to_string(),
+            what,
+            sampled: 0,
+            skipped: 0,
+            last: None,
+        })
+    }
+
+    /// The frame of timestep `expected` (every file's part), passing over the frames
+    /// before it and those off the sample grid.
+    fn frame_at(
+        &mut self,
+        expected: u64,
+        grid: &SampleGrid,
+        period_steps: u64,
+    ) -> Result<Vec<FramePart>, ImportError> {
+        loop {
+            let next = self.set.next_timestep();
+            match next {
+                Some(s) if s < expected || (s - grid.step_t0) % grid.every != 0 => {
+                    let (_, parts) = self.set.read_next(true)?.expect("a frame is next");
+                    self.last = parts.first().map(|p| (s, p.path.clone()));
+                    self.skipped += 1;
+                }
+                Some(s) if s == expected => {
+                    let (_, parts) = self.set.read_next(false)?.expect("a frame is next");
+                    self.last = parts.first().map(|p| (s, p.path.clone()));
+                    self.sampled += 1;
+                    return Ok(parts);
+                }
+                _ => {
+                    // a damaged or misordered frame further on is the more precise error
+                    while self.set.read_next(true)?.is_some() {}
+                    let what = self.what;
+                    let found = match (next, &self.last) {
+                        (Some(s), _) => format!("the next {what} dump is at timestep {s}"),
+                        (None, Some((s, path))) => {
+                            format!("the {what} dumps end at timestep {s} ({})", path.display())
+                        }
+                        (None, None) => format!("no {what} dump follows t0"),
+                    };
+                    let (step_t0, step_t1, every) = (grid.step_t0, grid.step_t1, grid.every);
+                    return Err(ImportError::Inconsistent(format!(
+                        "{}: no {what} dump at timestep {expected} (t0 = {step_t0} + {} steps): \
+                         the period τ = {period_steps} steps from t0 needs one every n = \
+                         {every} steps from t0 + n to t1 = {step_t1}, and {found}; dump the \
+                         {what}s every n steps (or give --n as a multiple of their spacing) \
+                         for the whole period",
+                        self.pattern,
+                        expected - step_t0,
+                    )));
+                }
+            }
+        }
+    }
 }
 
 /// The atom snapshots at `t0 + kτ`, in tdex ids.
@@ -708,6 +818,88 @@ impl Contacts<'_> {
         }
         let area = self.law.pair_area(distance, ri, rj);
         Ok((area > 0.0).then(|| area.sqrt()))
+    }
+}
+
+/// Turns wall contact frames (`compute wall/gran/local id contactArea`: mesh id, triangle
+/// id, particle id, area) into the sampler's wall rows `(i, particles + mantle, sqrt(a))`.
+struct WallContacts<'a> {
+    contacts: &'a Contacts<'a>,
+    /// The mantle's mesh id; the drum's other mesh (the end caps) is adiabatic.
+    mantle_mesh: u32,
+}
+
+impl WallContacts<'_> {
+    /// The particles touching the mantle at one timestep, in id order, each once: a
+    /// particle touching several of the mantle's facets (LIGGGHTS without `curvature` counts
+    /// a contact per facet) gets one row whose `sqrt(a)` is the facets' sum, so that it
+    /// conducts what LIGGGHTS conducted. Returns how many particles were merged so.
+    fn sample(
+        &self,
+        parts: &[FramePart],
+        walls: &mut Vec<(u32, u32, f64)>,
+    ) -> Result<u64, ImportError> {
+        walls.clear();
+        let mantle = self.contacts.ids.len() as u32; // body `particles + 0`: WallKind::DRUM
+        let mut values = Vec::new();
+        for part in parts {
+            if part.columns.len() != 4 {
+                return Err(part.error(
+                    part.columns_line,
+                    format!(
+                        "{} columns ({}): tdex reads the values of `compute wall/gran/local id \
+                         contactArea` (4 columns: mesh id, triangle id, particle id, contact \
+                         area) through `dump local` (docs/liggghts.md)",
+                        part.columns.len(),
+                        part.columns.join(" ")
+                    ),
+                ));
+            }
+            for (line, text) in part.lines() {
+                row_values(part, line, text, &mut values)?;
+                let mesh = number(part, line, &values, 0)?;
+                if mesh == f64::from(self.mantle_mesh) {
+                    let i = self.contacts.tdex_id(part, line, &values, 2)?;
+                    let area = number(part, line, &values, 3)?;
+                    if area > 0.0 {
+                        walls.push((i, mantle, self.sqrt_area(area, i)));
+                    }
+                } else if mesh.fract() != 0.0 || !(0.0..f64::from(DRUM_MESHES)).contains(&mesh) {
+                    return Err(part.error(
+                        line,
+                        format!(
+                            "mesh id `{}` is not one of the drum's {DRUM_MESHES} meshes (0, 1: \
+                             their places in `fix wall/gran ... meshes`; the mantle is mesh {})",
+                            values[0], self.mantle_mesh
+                        ),
+                    ));
+                }
+            }
+        }
+        walls.sort_by_key(|&(i, _, _)| i);
+        let mut merged = 0;
+        walls.dedup_by(|later, first| {
+            let same = later.0 == first.0;
+            if same {
+                first.2 += later.2;
+                merged += 1;
+            }
+            same
+        });
+        Ok(merged)
+    }
+
+    /// `sqrt(a)` of a contact of disc area `area` between particle `i` and the mantle, as
+    /// the case's law computes it (LIGGGHTS's wall `contactArea` is the disc
+    /// `π (2Rδ − δ²)` where the sphere cuts the wall).
+    fn sqrt_area(&self, area: f64, i: u32) -> f64 {
+        let law = &self.contacts.law;
+        if law.overlap_correction == 1.0 {
+            return area.sqrt();
+        }
+        let r = self.contacts.radius[i as usize];
+        let overlap = r - (r * r - area / std::f64::consts::PI).max(0.0).sqrt();
+        law.wall_sqrt_area(overlap, r)
     }
 }
 

@@ -41,6 +41,21 @@ pub enum ImportError {
         /// The other atom timesteps seen, with their files (`none` without any).
         others: String,
     },
+    /// The case heats its mantle, but no wall contacts were given: the mantle's heat would
+    /// be lost from the replay.
+    #[error(
+        "{}: drum.wall_temperature = {temperature} K (a heated mantle), but no wall contact \
+         dumps were given: the replay heats the bed through the wall rows they make",
+        case.display()
+    )]
+    HeatedMantleWithoutWallDumps { case: PathBuf, temperature: f64 },
+    /// Wall contacts were given for a case whose walls are adiabatic.
+    #[error(
+        "{pattern}: wall contact dumps for {}, whose walls are adiabatic (no \
+         drum.wall_temperature): its wall rows would conduct from a mantle without a temperature",
+        case.display()
+    )]
+    WallDumpsWithoutHeatedMantle { case: PathBuf, pattern: String },
     /// The case cannot describe an imported run.
     #[error("{0}")]
     Case(String),
