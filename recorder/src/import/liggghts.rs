@@ -254,7 +254,7 @@ impl SampledFrames {
         loop {
             let next = self.set.next_timestep();
             match next {
-                Some(s) if s < expected || (s - grid.step_t0) % grid.every != 0 => {
+                Some(s) if s < expected || !(s - grid.step_t0).is_multiple_of(grid.every) => {
                     let (_, parts) = self.set.read_next(true)?.expect("a frame is next");
                     self.last = parts.first().map(|p| (s, p.path.clone()));
                     self.skipped += 1;
