@@ -1,13 +1,25 @@
 #!/usr/bin/env python3
 """Write a LIGGGHTS 3.8 deck and the drum STL for a tdex case file.
 
-usage: deck_from_case.py CASE.toml OUTDIR [--dumps N PERIODS [--per-proc] [--from-t1-period P]]
+usage: deck_from_case.py CASE.toml OUTDIR [--facets F] [--default-curvature]
+                         [--dumps N PERIODS [--per-proc] [--from-t1-period P]]
 
 Writes OUTDIR/in.drum (every value of the case substituted, paths relative to
 OUTDIR: run it from there) and the drum mesh: OUTDIR/drum.stl (mantle + both end
 caps, one rotating mesh) or, with `end_caps = "fixed"`, drum_mantle.stl and
 drum_caps.stl.  Drum axis y through the origin, gravity -z, type 1 = particles,
 type 2 = wall (same E, nu, k, c as the particles).  Python stdlib only.
+
+--facets F sets the number of facets around the mantle (default 96).
+
+A heated mantle (`drum.wall_temperature`) is its own mesh, drum_mantle.stl, with
+`temperature Tw` (fix heat/gran/conduction then conducts between it and the particles
+touching it, with the wall's conductivity `drum.wall_conductivity`), and the end caps
+are a second mesh, drum_caps.stl, without temperature (adiabatic, as in tdex); with
+rotating end caps both meshes turn.  The mantle's `curvature` is 1.5 x the angle
+between neighbouring facets (360/F degrees), so that a sphere touching several mantle
+facets at once makes one contact with it; --default-curvature leaves LIGGGHTS' default
+(0.256 degrees), with which such a sphere makes a contact with each facet.
 
 With --dumps N PERIODS the heating phase is 1 + PERIODS drum revolutions and the deck
 writes the dumps `tdex import liggghts` reads (docs/liggghts.md): the atoms at t0 and
@@ -28,7 +40,8 @@ import sys
 import tomllib
 from pathlib import Path
 
-N_THETA = 96      # facets around the circumference
+N_THETA = 96      # facets around the circumference (default of --facets)
+CURVATURE_FACTOR = 1.5  # mantle curvature (deg) = this x 360 / facets, unless --default-curvature
 AXIAL_SEG = 0.02  # target length (m) of one mantle facet along the axis
 
 
@@ -42,15 +55,15 @@ def facet(a, b, c):
     return lines + [" endloop", "endfacet"]
 
 
-def write_stl(path, R, L, mantle=True, caps=True):
+def write_stl(path, R, L, mantle=True, caps=True, n_theta=N_THETA):
     """ASCII STL, normals pointing into the drum (LIGGGHTS does not need them)."""
-    ring = [(R * math.cos(2 * math.pi * k / N_THETA), R * math.sin(2 * math.pi * k / N_THETA))
-            for k in range(N_THETA)]
+    ring = [(R * math.cos(2 * math.pi * k / n_theta), R * math.sin(2 * math.pi * k / n_theta))
+            for k in range(n_theta)]
     ny = max(1, math.ceil(L / AXIAL_SEG))
     ys = [-L / 2 + L * j / ny for j in range(ny + 1)]
     out = ["solid drum"]
-    for k in range(N_THETA):
-        (x0, z0), (x1, z1) = ring[k], ring[(k + 1) % N_THETA]
+    for k in range(n_theta):
+        (x0, z0), (x1, z1) = ring[k], ring[(k + 1) % n_theta]
         if mantle:
             for y0, y1 in zip(ys, ys[1:]):
                 out += facet((x0, y0, z0), (x1, y0, z1), (x1, y1, z1))
@@ -113,7 +126,46 @@ def import_dumps(argv, nper, nstart, rotating):
     return re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), IMPORT_DUMPS)
 
 
+def mesh_options(argv):
+    """Take --facets F and --default-curvature out of argv; return (facets, default_curvature)."""
+    facets, default_curv = N_THETA, False
+    while "--default-curvature" in argv:
+        argv.remove("--default-curvature")
+        default_curv = True
+    while "--facets" in argv:
+        i = argv.index("--facets")
+        if i + 1 >= len(argv) or not argv[i + 1].isdigit() or int(argv[i + 1]) < 3:
+            sys.exit("--facets wants a whole number >= 3")
+        facets = int(argv[i + 1])
+        del argv[i:i + 2]
+    return facets, default_curv
+
+
+def replace_once(text, old, new):
+    if text.count(old) != 1:
+        sys.exit(f"the deck template has {text.count(old)} lines `{old}` where 1 was expected")
+    return text.replace(old, new)
+
+
+def heated_mantle(deck, v, caps_turn, Kw):
+    """The heated mantle's edits of the filled-in deck: the wall's conductivity (type 2) and,
+    with rotating end caps, a second move/mesh for the caps mesh."""
+    if Kw is not None and float(Kw) != float(v["k"]):
+        deck = replace_once(deck, f"thermalConductivity peratomtype {v['k']} {v['k']}\n",
+                            f"thermalConductivity peratomtype {v['k']} {float(Kw)!r}\n")
+    deck = replace_once(deck, "# drum (adiabatic: no 'temperature' on the meshes)\n",
+                        "# drum: the mantle held at its 'temperature' (conducts to the particles touching it),"
+                        " the end caps adiabatic\n")
+    if caps_turn:
+        rot = (f"fix rot all move/mesh mesh mantle rotate origin 0. 0. 0. axis 0. 1. 0. "
+               f"period {v['period']}\n")
+        deck = replace_once(deck, rot, rot + rot.replace("fix rot all", "fix rotcaps all")
+                            .replace("mesh mantle", "mesh caps"))
+    return deck
+
+
 def main():
+    facets, default_curv = mesh_options(sys.argv)
     if len(sys.argv) < 3 or (len(sys.argv) > 3 and sys.argv[3] != "--dumps"):
         sys.exit(__doc__)
     case_path, out = Path(sys.argv[1]), Path(sys.argv[2])
@@ -122,23 +174,37 @@ def main():
                                   c["time"], c["temperature"])
     cond = c.get("conduction", {})
     # refuse what this deck cannot reproduce rather than run something else
-    if temp["mode"] != "split":
-        sys.exit("only temperature.mode = 'split' is supported")
+    if temp["mode"] not in ("split", "uniform"):
+        sys.exit(f"temperature.mode = {temp['mode']!r} is not supported")
     if cond.get("contact_area", "overlap") != "overlap":
         sys.exit("LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area")
-    if drum.get("wall_temperature") is not None:
-        sys.exit("heated walls are not supported by this deck")
+    Tw = drum.get("wall_temperature")
+    if Tw is not None and len(sys.argv) > 3:
+        sys.exit("--dumps: tdex import liggghts refuses a heated mantle")
+    if temp["mode"] == "uniform":  # the deck's hot/cold groups, both at the one value
+        T_hot = T_cold = temp["value"]
+    else:
+        T_hot, T_cold = temp["hot"], temp["cold"]
 
     out.mkdir(parents=True, exist_ok=True)
     R, L, rp, dt = drum["radius"], drum["length"], p["radius"], t["dt"]
-    if drum.get("end_caps", "rotating") == "fixed":
-        write_stl(out / "drum_mantle.stl", R, L, caps=False)
-        write_stl(out / "drum_caps.stl", R, L, mantle=False)
+    caps_turn = drum.get("end_caps", "rotating") != "fixed"
+    if Tw is not None:
+        # the heated mantle and the adiabatic end caps as two meshes; only the mantle has a temperature
+        write_stl(out / "drum_mantle.stl", R, L, caps=False, n_theta=facets)
+        write_stl(out / "drum_caps.stl", R, L, mantle=False, n_theta=facets)
+        curv = "" if default_curv else f" curvature {CURVATURE_FACTOR * 360.0 / facets!r}"
+        mesh_fixes = (f"fix mantle all mesh/surface file drum_mantle.stl type 2 temperature {float(Tw)!r}{curv}\n"
+                      "fix caps all mesh/surface file drum_caps.stl type 2")
+        n_meshes, meshes, rotating = 2, "mantle caps", "mantle"
+    elif not caps_turn:
+        write_stl(out / "drum_mantle.stl", R, L, caps=False, n_theta=facets)
+        write_stl(out / "drum_caps.stl", R, L, mantle=False, n_theta=facets)
         mesh_fixes = ("fix mantle all mesh/surface file drum_mantle.stl type 2\n"
                       "fix caps all mesh/surface file drum_caps.stl type 2")
         n_meshes, meshes, rotating = 2, "mantle caps", "mantle"
     else:
-        write_stl(out / "drum.stl", R, L)
+        write_stl(out / "drum.stl", R, L, n_theta=facets)
         mesh_fixes, n_meshes, meshes, rotating = "fix drum all mesh/surface file drum.stl type 2", 1, "drum", "drum"
 
     ax = temp.get("split_axis", "x")
@@ -164,7 +230,7 @@ def main():
                     if E_real else ""),
         area_corr="yes" if E_real else "no",
         mesh_fixes=mesh_fixes, n_meshes=n_meshes, meshes=meshes, rotating=rotating,
-        T_init=0.5 * (temp["hot"] + temp["cold"]), T_hot=temp["hot"], T_cold=temp["cold"],
+        T_init=0.5 * (T_hot + T_cold), T_hot=T_hot, T_cold=T_cold,
         rins=R - 1.5 * rp, yins=L / 2 - 1.5 * rp, seed1=s1, seed2=s2, seed3=s3,
         nsettle=steps(t["settle"], dt, "time.settle"),
         nsettle_rest=steps(t["settle"], dt, "time.settle") - 1,
@@ -180,6 +246,8 @@ def main():
     v["box"] = f"region          domain block -{v['bx']} {v['bx']} -{v['by']} {v['by']} -{v['bx']} {v['bx']} units box\ncreate_box      2 domain"
     v["start"] = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), START)
     deck = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), DECK)
+    if Tw is not None:
+        deck = heated_mantle(deck, v, caps_turn, drum.get("wall_conductivity"))
     (out / "in.drum").write_text(deck)
     print(f"wrote {out}/in.drum: N={v['N']} R={R} L={L} settle={v['nsettle']} spin={v['nspin']} "
           f"heat={v['nheat']} steps, rolling={v['rolling']}, seeds {s1} {s2} {s3}")

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Run the LIGGGHTS 3.8 peer of a tdex case on one process and print its summary.
-# usage: tests/liggghts/run_case.sh CASE.toml OUTDIR
+# usage: tests/liggghts/run_case.sh CASE.toml OUTDIR [--facets F] [--default-curvature]
+#   (the options go to deck_from_case.py)
 # OUTDIR gets: case.toml (copy), in.drum + drum STL (generated), log.liggghts, screen.txt,
 # marks.txt (per-phase wall/CPU marks), temps.txt (every 100 heating steps), dump_T.{start,end}.txt,
 # summary.json.  Prefix with `nice -n 5` on a shared machine.
@@ -12,7 +13,7 @@ mkdir -p "$out"
 out="$(cd "$out" && pwd)"
 rm -f "$out"/{marks.txt,temps.txt,dump_T.start.txt,dump_T.end.txt,summary.json}
 cp "$case_file" "$out/case.toml"
-python3 "$here/deck_from_case.py" "$out/case.toml" "$out"
+python3 "$here/deck_from_case.py" "$out/case.toml" "$out" "${@:3}"
 cd "$out"
 echo "loadavg before: $(cat /proc/loadavg)" > load.txt
 start=$(date +%s.%N)

@@ -1,7 +1,11 @@
 #!/usr/bin/env python3
 """Print one JSON object summarising a LIGGGHTS peer run made by run_case.sh.
 
-usage: summarize.py OUTDIR
+usage: summarize.py OUTDIR [--bed-mean]
+
+With --bed-mean it prints instead one row per `temps.txt` row of the heating run: step,
+time since t0 (s) and the bed mean temperature (K), the count-weighted mean of the hot and
+cold means.
 
 Reads OUTDIR/case.toml, log.liggghts, screen.txt, marks.txt, temps.txt and
 dump_T.{start,end}.txt.  Temperatures and heat come from the deck's prints (15
@@ -33,7 +37,7 @@ def main():
     case = tomllib.loads((out / "case.toml").read_text())
     N, rp = case["particles"]["count"], case["particles"]["radius"]
     mc = case["material"]["density"] * 4 / 3 * math.pi * rp ** 3 * case["material"]["heat_capacity"]
-    T_hot = case["temperature"]["hot"]
+    split = case["temperature"]["mode"] == "split"
 
     log = (out / "log.liggghts").read_text().splitlines()
     screen = (out / "screen.txt").read_text().splitlines()
@@ -53,6 +57,15 @@ def main():
             if l.strip() and not l.startswith("#")]
     rows = {int(r[0]): r for r in rows if start["step"] < r[0] <= end["step"]}
     z_mean = sum(r[4] for r in rows.values()) / len(rows)
+    nh, nc = start["hot"], start["cold"]
+    bed = lambda Th, Tc: (nh * Th + nc * Tc) / (nh + nc)
+    if sys.argv[2:] == ["--bed-mean"]:
+        dt = case["time"]["dt"]
+        print("# step t_since_t0(s) bed_mean_T(K)")
+        print("%d %.6g %.15g" % (start["step"], 0.0, bed(start["Thot"], start["Tcold"])))
+        for k, r in sorted(rows.items()):
+            print("%d %.6g %.15g" % (k, (k - start["step"]) * dt, bed(r[1], r[2])))
+        return
 
     warnings = {}
     for i, l in enumerate(screen):
@@ -61,9 +74,9 @@ def main():
             warnings[w] = warnings.get(w, 0) + 1
 
     d0, d1 = read_dump(out / "dump_T.start.txt"), read_dump(out / "dump_T.end.txt")
-    hot_ids = [i for i, T in d0.items() if T == T_hot]
-    cold_ids = [i for i in d0 if i not in set(hot_ids)]
-    mean = lambda d, ids: sum(d[i] for i in ids) / len(ids)
+    hot_ids = [i for i, T in d0.items() if T == case["temperature"]["hot"]] if split else []
+    cold_ids = [i for i in d0 if i not in set(hot_ids)] if split else []
+    mean = lambda d, ids: sum(d[i] for i in ids) / len(ids) if ids else None
 
     print(json.dumps({
         "case": case.get("name", ""),
@@ -79,6 +92,9 @@ def main():
         "cold_mean_start": start["Tcold"],
         "hot_mean_end": end["Thot"],
         "cold_mean_end": end["Tcold"],
+        "bed_mean_start": bed(start["Thot"], start["Tcold"]),
+        "bed_mean_end": bed(end["Thot"], end["Tcold"]),
+        "wall_temperature": case["drum"].get("wall_temperature"),
         "total_heat_start": start["Q"],
         "total_heat_end": end["Q"],
         "total_heat_rel_change": (end["Q"] - start["Q"]) / start["Q"],
@@ -93,6 +109,7 @@ def main():
         "from_dumps": {
             "particles_start": len(d0), "particles_end": len(d1),
             "hot_mean_end": mean(d1, hot_ids), "cold_mean_end": mean(d1, cold_ids),
+            "bed_mean_start": mean(d0, list(d0)), "bed_mean_end": mean(d1, list(d1)),
             "total_heat_start": mc * sum(d0.values()), "total_heat_end": mc * sum(d1.values()),
         },
         "warnings": warnings,
