@@ -99,12 +99,11 @@ pub fn run(plan: &ImportPlan) -> Result<()> {
         println!(
             "mantle        {frames} wall contact frames sampled; {}",
             match summary.wall_contacts_merged {
-                0 => "one contact per particle and sample (the mantle's facets count as one \
-                      surface)"
-                    .to_string(),
+                0 => "one contact per particle and sample".to_string(),
                 m => format!(
-                    "{m} particle samples touched several facets at once (LIGGGHTS's default \
-                     curvature): each is one wall row with the facets' summed conductance, as \
+                    "{m} particle samples touched the mantle through several facets at once (a \
+                     contact a facet, as LIGGGHTS counts them where facets meet at more than \
+                     `curvature`): each is one wall row with the facets' summed conductance, as \
                      LIGGGHTS conducted"
                 ),
             }

@@ -5,7 +5,7 @@
 use crate::cli::InspectPlan;
 use crate::fmt;
 use anyhow::Result;
-use extrapolate::replay::{self, Bodies, CflRow};
+use extrapolate::replay::{self, Bodies, CflRow, Exchanges, RoleTemperatures, Scheme, SyncScratch};
 use serde::Serialize;
 use tdex_format::extrapolation::Roles;
 use tdex_format::{
@@ -187,8 +187,25 @@ struct Inspection {
     /// `Δt_c^max` allow.
     suggested_n_unconstrained: Option<u64>,
     max_cfl: Option<CflRow>,
+    /// With a heated mantle: the heat it gave the bed over the first recorded period, in the
+    /// DEM and from the period's table replayed on the `t0` temperatures (`null` with
+    /// adiabatic walls).
+    recorded_wall_heat: Option<RecordedWallHeat>,
     snapshots: Vec<SnapshotSummary>,
     costs: Option<RecordingCosts>,
+}
+
+/// The heat (J) the conducting walls gave the bed over the first recorded period `[t0, t1]`:
+/// `dem` is `Σ C T` at `t1` less at `t0` (the other walls are adiabatic, the contacts
+/// conserve it), `replayed` the same from the period's rows applied to the `t0` temperatures
+/// with the explicit scheme, each particle in its own role. Their difference is what the
+/// table's sampling (`n`, `Δt_c^max`, the areas) loses of the wall's heat.
+#[derive(Debug, Serialize)]
+struct RecordedWallHeat {
+    dem: f64,
+    replayed: f64,
+    /// `(replayed − dem) / dem`.
+    relative_difference: f64,
 }
 
 /// `tdex inspect --json` on an extrapolation (keys documented in docs/user-guide.md).
@@ -455,6 +472,11 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
     if info.recorded_periods == 1 {
         period_rows.clear();
     }
+    let recorded_wall_heat = if conducting_walls(&info) > 0 {
+        recorded_wall_heat(reader, &info, &snapshots, t0)?
+    } else {
+        None
+    };
     let summary = reader.summary().cloned();
     let n = info.sample_every as u64;
     let histogram: Vec<HistogramBin> = summary.as_ref().map_or_else(Vec::new, |s| {
@@ -504,6 +526,7 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
         suggested_n,
         suggested_n_unconstrained,
         max_cfl: found.worst,
+        recorded_wall_heat,
         snapshots: snapshots
             .iter()
             .map(|s| {
@@ -525,6 +548,40 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
         costs: reader.costs().cloned(),
     };
     emit(plan.json, &inspection, print_human)
+}
+
+/// The wall's heat over the first recorded period, in the DEM and replayed from `t0` (see
+/// [`RecordedWallHeat`]); `None` without a snapshot at `t1`.
+fn recorded_wall_heat(
+    reader: &RecordingReader,
+    info: &tdex_format::RecordingInfo,
+    snapshots: &[Snapshot],
+    t0: &Snapshot,
+) -> Result<Option<RecordedWallHeat>> {
+    let Some(t1) = snapshots.iter().find(|s| s.index == 1) else {
+        return Ok(None);
+    };
+    let bodies = Bodies::of(info, t0);
+    // snapshots list the particles in id order, and at t0 particle k plays role k
+    let mut roles = RoleTemperatures::new(&t0.temp, &bodies);
+    let mut scratch = SyncScratch::default();
+    let mut rows = Exchanges::with_room_for(0);
+    for batch in reader.period_table(0) {
+        rows.clear();
+        for row in &batch?.rows {
+            rows.push_row(row, info, 0);
+        }
+        replay::apply_rows_with(&mut roles, &rows, &bodies, Scheme::Explicit, &mut scratch);
+    }
+    scratch.flush(&mut roles);
+    let start = replay::total_heat(&t0.temp, &bodies);
+    let dem = replay::total_heat(&t1.temp, &bodies) - start;
+    let replayed = roles.total_heat(&bodies) - start;
+    Ok(Some(RecordedWallHeat {
+        dem,
+        replayed,
+        relative_difference: (replayed - dem) / dem,
+    }))
 }
 
 fn print_human(s: &Inspection) {
@@ -590,6 +647,14 @@ fn print_human(s: &Inspection) {
         );
     }
     println!("suggested n   {}", suggested_n_line(s));
+    if let Some(h) = &s.recorded_wall_heat {
+        println!(
+            "wall heat     over the recorded period: {} J in the DEM, {} J from its table replayed from t0 ({:+.2} %)",
+            fmt::sig(h.dem, 6),
+            fmt::sig(h.replayed, 6),
+            100.0 * h.relative_difference
+        );
+    }
     if let Some(w) = &s.max_cfl {
         println!(
             "max CFL c     {:.4} (row {}: bodies {} and {}, m = {} steps, sqrt(a) = {:.4e} m){}",

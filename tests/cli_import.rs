@@ -551,3 +551,132 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
         );
     }
 }
+
+/// Σ m c T (J) of a LIGGGHTS atom dump frame (`... radius f_Temp` columns), for the case's
+/// density and heat capacity.
+fn dump_heat(path: &Path, density: f64, heat_capacity: f64) -> f64 {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let columns: Vec<&str> = lines
+        .by_ref()
+        .find(|l| l.starts_with("ITEM: ATOMS"))
+        .unwrap()
+        .split_whitespace()
+        .skip(2)
+        .collect();
+    let at = |name| columns.iter().position(|c| *c == name).unwrap();
+    let (r, t) = (at("radius"), at("f_Temp"));
+    lines
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            density * heat_capacity * 4.0 / 3.0 * std::f64::consts::PI * v[r].powi(3) * v[t]
+        })
+        .sum()
+}
+
+/// A heated mantle across the bridge: LIGGGHTS 3.8 runs `cases/import_heated_drum.toml` (the
+/// mantle its own mesh with `temperature`, the wall contacts dumped), tdex imports the wall
+/// contacts as wall rows, and the heat the mantle gives the bed is LIGGGHTS's: over the
+/// recorded period with the table replayed from t0, and over the first extrapolated period
+/// against LIGGGHTS's own continuation (figures in docs/validation.md).
+#[test]
+fn a_heated_liggghts_run_imports_with_its_wall_contacts() {
+    if !liggghts_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = dir.path();
+    let case = repo().join("cases/import_heated_drum.toml");
+    let deck = std::process::Command::new("python3")
+        .arg(repo().join("tests/liggghts/deck_from_case.py"))
+        .arg(&case)
+        .arg(run_dir)
+        .args(["--dumps", "10", "1", "--per-proc"])
+        .output()
+        .unwrap();
+    assert!(
+        deck.status.success(),
+        "{}",
+        String::from_utf8_lossy(&deck.stderr)
+    );
+    let started = std::time::Instant::now();
+    let lg = std::process::Command::new("liggghts")
+        .args(["-in", "in.drum", "-log", "log.liggghts", "-echo", "none"])
+        .current_dir(run_dir)
+        .output()
+        .unwrap();
+    assert!(
+        lg.status.success(),
+        "liggghts failed: {}",
+        String::from_utf8_lossy(&lg.stdout)
+    );
+    eprintln!(
+        "LIGGGHTS: {:.1} s for import_heated_drum (one revolution to t0, two dumped)",
+        started.elapsed().as_secs_f64()
+    );
+    let (run, extra) = (run_dir.join("run.mcap"), run_dir.join("extra.mcap"));
+    let path = |name: &str| run_dir.join(name).to_string_lossy().into_owned();
+    let imported = tdex_ok(&[
+        "import",
+        "liggghts",
+        "--atoms",
+        &path("dump_atoms.*.%"),
+        "--contacts",
+        &path("dump_pairs.*"),
+        "--wall-contacts",
+        &path("dump_walls.*"),
+        "--case",
+        case.to_str().unwrap(),
+        "-o",
+        run.to_str().unwrap(),
+        "--json",
+    ]);
+    let imported: serde_json::Value = serde_json::from_str(&imported).unwrap();
+    assert_eq!(imported["wall_frames"], 2000, "{imported}");
+    let info = RecordingReader::open(&run).unwrap().info().clone();
+    assert_eq!(info.walls[0].temperature, Some(60.0));
+    assert!(info.walls[1..].iter().all(|w| w.temperature.is_none()));
+
+    // over the recorded period: the table replayed from t0 gives the mantle's heat as
+    // LIGGGHTS conducted it (measured +0.06 %)
+    let inspected: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["inspect", run.to_str().unwrap(), "--json"])).unwrap();
+    let heat = &inspected["recorded_wall_heat"];
+    eprintln!("recorded period's wall heat: {heat}");
+    assert!(heat["dem"].as_f64().unwrap() > 0.0, "{heat}");
+    assert!(
+        heat["relative_difference"].as_f64().unwrap().abs() < 0.02,
+        "{heat}"
+    );
+
+    // over the first extrapolated period against LIGGGHTS's own [t1, t2] (measured −0.84 %)
+    tdex_ok(&[
+        "extrapolate",
+        run.to_str().unwrap(),
+        "--periods",
+        "1",
+        "-o",
+        extra.to_str().unwrap(),
+    ]);
+    let x: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["inspect", extra.to_str().unwrap(), "--json"])).unwrap();
+    let replayed = x["wall_heat"].as_f64().unwrap();
+    let (step_t1, step_t2) = (
+        info.step_t0 + info.period_steps,
+        info.step_t0 + 2 * info.period_steps,
+    );
+    let liggghts = dump_heat(
+        &run_dir.join(format!("dump_atoms.{step_t2}.0")),
+        info.density,
+        info.heat_capacity,
+    ) - dump_heat(
+        &run_dir.join(format!("dump_atoms.{step_t1}.0")),
+        info.density,
+        info.heat_capacity,
+    );
+    eprintln!("first extrapolated period's wall heat: {replayed} J, LIGGGHTS {liggghts} J");
+    assert!(
+        (replayed - liggghts).abs() < 0.02 * liggghts,
+        "the extrapolation's mantle gave {replayed} J, LIGGGHTS's {liggghts} J"
+    );
+}

@@ -23,7 +23,8 @@ facets at once makes one contact with it; --default-curvature leaves LIGGGHTS' d
 
 With --dumps N PERIODS the heating phase is 1 + PERIODS drum revolutions and the deck
 writes the dumps `tdex import liggghts` reads (docs/liggghts.md): the atoms at t0 and
-after every revolution (dump_atoms.STEP) and the contacts every N steps during the
+after every revolution (dump_atoms.STEP), for a heated mantle the wall contacts
+(dump_walls.STEP: mesh 0 the mantle, 1 the end caps) and the contacts every N steps during the
 first revolution (dump_pairs.STEP); with --per-proc the atoms go to one file per MPI
 process and timestep (dump_atoms.STEP.PROC; LIGGGHTS 3.8 writes no header in the `dump local`
 files of processes other than 0, so the contacts are always gathered into one file).  t0 must then be a whole number of revolutions and
@@ -101,19 +102,23 @@ dump da all custom @nper@ dump_atoms.*@proc@ id type x y z vx vy vz radius f_Tem
 dump_modify da format "%d %d %.17g %.17g %.17g %.17g %.17g %.17g %.17g %.17g"
 dump dc all local @n@ dump_pairs.* c_pc[1] c_pc[2] c_pc[3] c_pc[4]
 dump_modify dc format "%.0f %.0f %.0f %.17g"
-run @nper@
+@wall_dump@run @nper@
 undump dc
-@restart_rotation@
+@wall_undump@@restart_rotation@
 run @nrest@"""
 
 
-def import_dumps(argv, nper, nstart, rotating):
+def import_dumps(argv, nper, nstart, rotating, heated, caps_turn):
     """The heating runs of a deck that writes the import dumps
-    (--dumps N PERIODS [--per-proc] [--from-t1-period P])."""
+    (--dumps N PERIODS [--per-proc] [--from-t1-period P]); with a heated mantle also the wall
+    contacts (mesh 0 the mantle, mesh 1 the end caps) every N steps of the recorded revolution."""
     restart = ""
     if len(argv) >= 2 and argv[-2] == "--from-t1-period":
         restart = (f"unfix rot\nfix rot all move/mesh mesh {rotating} rotate origin 0. 0. 0. "
                    f"axis 0. 1. 0. period {float(argv[-1])!r}")
+        if heated and caps_turn:  # the caps turn with the mantle, by their own move/mesh
+            restart += ("\nunfix rotcaps\nfix rotcaps all move/mesh mesh caps rotate origin 0. 0. 0. "
+                        f"axis 0. 1. 0. period {float(argv[-1])!r}")
         argv = argv[:-2]
     if len(argv) not in (3, 4) or argv[0] != "--dumps" or argv[3:] not in ([], ["--per-proc"]):
         sys.exit(__doc__)
@@ -121,8 +126,11 @@ def import_dumps(argv, nper, nstart, rotating):
     if n < 1 or periods < 0 or nper % n or nstart % nper:
         sys.exit(f"--dumps {n} {periods}: t0 = step {nstart} must be a multiple of one revolution "
                  f"({nper} steps), itself a multiple of n = {n}")
+    wall_dump = (f"dump dw all local {n} dump_walls.* c_wc[1] c_wc[2] c_wc[3] c_wc[4]\n"
+                 'dump_modify dw format "%.0f %.0f %.0f %.17g"\n') if heated else ""
     v = dict(n=n, periods=periods, nper=nper, nrest=periods * nper,
-             proc=".%" if argv[3:] else "", restart_rotation=restart)
+             proc=".%" if argv[3:] else "", restart_rotation=restart,
+             wall_dump=wall_dump, wall_undump="undump dw\n" if heated else "")
     return re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), IMPORT_DUMPS)
 
 
@@ -159,8 +167,11 @@ def heated_mantle(deck, v, caps_turn, Kw):
     if caps_turn:
         rot = (f"fix rot all move/mesh mesh mantle rotate origin 0. 0. 0. axis 0. 1. 0. "
                f"period {v['period']}\n")
-        deck = replace_once(deck, rot, rot + rot.replace("fix rot all", "fix rotcaps all")
-                            .replace("mesh mantle", "mesh caps"))
+        if rot not in deck:
+            sys.exit(f"the deck template has no line `{rot.strip()}`")
+        # the spin-up's; a restart at t1 (--from-t1-period) moves the caps itself
+        deck = deck.replace(rot, rot + rot.replace("fix rot all", "fix rotcaps all")
+                            .replace("mesh mantle", "mesh caps"), 1)
     return deck
 
 
@@ -179,8 +190,6 @@ def main():
     if cond.get("contact_area", "overlap") != "overlap":
         sys.exit("LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area")
     Tw = drum.get("wall_temperature")
-    if Tw is not None and len(sys.argv) > 3:
-        sys.exit("--dumps: tdex import liggghts refuses a heated mantle")
     if temp["mode"] == "uniform":  # the deck's hot/cold groups, both at the one value
         T_hot = T_cold = temp["value"]
     else:
@@ -241,7 +250,10 @@ def main():
     nper = steps(drum["rotation_period"], dt, "drum.rotation_period")
     # LIGGGHTS wants compute pair/gran/local defined before the first run
     v["pair_compute"] = "compute pc all pair/gran/local id contactArea" if len(sys.argv) > 3 else ""
-    v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"], rotating)
+    if len(sys.argv) > 3 and Tw is not None:
+        v["pair_compute"] += "\ncompute wc all wall/gran/local id contactArea"
+    v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"], rotating,
+                                   Tw is not None, caps_turn)
                       if len(sys.argv) > 3 else f"run {v['nheat']}")
     v["box"] = f"region          domain block -{v['bx']} {v['bx']} -{v['by']} {v['by']} -{v['bx']} {v['bx']} units box\ncreate_box      2 domain"
     v["start"] = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), START)

@@ -51,8 +51,9 @@ pub struct ImportReport {
     /// Atom frames passed over (not at a `t0 + kτ`).
     pub atom_frames_skipped: u64,
     /// For a heated mantle: the wall contact frames sampled, and the particle samples that
-    /// touched the mantle through several of its facets at once (LIGGGHTS's default
-    /// `curvature`), merged into one wall row with the facets' summed `sqrt(a)`.
+    /// touched the mantle through several of its facets at once (LIGGGHTS counts a contact a
+    /// facet where facets meet at more than `curvature`), merged into one wall row with the
+    /// facets' summed `sqrt(a)`.
     pub wall_frames: Option<u64>,
     pub wall_contacts_merged: u64,
 }
@@ -831,9 +832,10 @@ struct WallContacts<'a> {
 
 impl WallContacts<'_> {
     /// The particles touching the mantle at one timestep, in id order, each once: a
-    /// particle touching several of the mantle's facets (LIGGGHTS without `curvature` counts
-    /// a contact per facet) gets one row whose `sqrt(a)` is the facets' sum, so that it
-    /// conducts what LIGGGHTS conducted. Returns how many particles were merged so.
+    /// particle touching several of the mantle's facets (LIGGGHTS counts a contact a facet
+    /// where they meet at more than `curvature`, so at every edge with its default 0.256°)
+    /// gets one row whose `sqrt(a)` is the facets' sum, so that it conducts what LIGGGHTS
+    /// conducted. Returns how many particles were merged so.
     fn sample(
         &self,
         parts: &[FramePart],
