@@ -409,22 +409,14 @@ fn missing_contact_frames_and_a_wrong_case_are_refused() {
     assert!(err.contains("nothing.*: no file matches"), "{err}");
 }
 
-/// Runs LIGGGHTS 3.8 on `cases/import_drum.toml` with the import dumps (one revolution
-/// recorded, three more as reference), imports it, extrapolates three periods and compares
-/// them with the LIGGGHTS continuation, and tdex's own run of the case with it too (figures
-/// in docs/validation.md).
-#[test]
-fn a_liggghts_run_imports_extrapolates_and_compares() {
-    if !liggghts_available() {
-        return;
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let run_dir = dir.path();
+/// Writes the deck of `case` with `deck_args` (`tests/liggghts/deck_from_case.py`) into
+/// `run_dir` and runs LIGGGHTS 3.8 there on one process.
+fn run_liggghts(case: &Path, run_dir: &Path, deck_args: &[&str]) {
     let deck = std::process::Command::new("python3")
         .arg(repo().join("tests/liggghts/deck_from_case.py"))
-        .arg(repo().join("cases/import_drum.toml"))
+        .arg(case)
         .arg(run_dir)
-        .args(["--dumps", "10", "3", "--per-proc"])
+        .args(deck_args)
         .output()
         .unwrap();
     assert!(
@@ -444,8 +436,28 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
         String::from_utf8_lossy(&lg.stdout)
     );
     eprintln!(
-        "LIGGGHTS: {:.1} s for import_drum (one revolution to t0, four dumped)",
-        started.elapsed().as_secs_f64()
+        "LIGGGHTS: {:.1} s for {} ({})",
+        started.elapsed().as_secs_f64(),
+        case.display(),
+        deck_args.join(" ")
+    );
+}
+
+/// Runs LIGGGHTS 3.8 on `cases/import_drum.toml` with the import dumps (one revolution
+/// recorded, three more as reference), imports it, extrapolates three periods and compares
+/// them with the LIGGGHTS continuation, and tdex's own run of the case with it too (figures
+/// in docs/validation.md).
+#[test]
+fn a_liggghts_run_imports_extrapolates_and_compares() {
+    if !liggghts_available() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let run_dir = dir.path();
+    run_liggghts(
+        &repo().join("cases/import_drum.toml"),
+        run_dir,
+        &["--dumps", "10", "3", "--per-proc"],
     );
     // gzip every other contact dump: the import reads both
     let mut pairs: Vec<PathBuf> = std::fs::read_dir(run_dir)
@@ -587,33 +599,7 @@ fn a_heated_liggghts_run_imports_with_its_wall_contacts() {
     let dir = tempfile::tempdir().unwrap();
     let run_dir = dir.path();
     let case = repo().join("cases/import_heated_drum.toml");
-    let deck = std::process::Command::new("python3")
-        .arg(repo().join("tests/liggghts/deck_from_case.py"))
-        .arg(&case)
-        .arg(run_dir)
-        .args(["--dumps", "10", "1", "--per-proc"])
-        .output()
-        .unwrap();
-    assert!(
-        deck.status.success(),
-        "{}",
-        String::from_utf8_lossy(&deck.stderr)
-    );
-    let started = std::time::Instant::now();
-    let lg = std::process::Command::new("liggghts")
-        .args(["-in", "in.drum", "-log", "log.liggghts", "-echo", "none"])
-        .current_dir(run_dir)
-        .output()
-        .unwrap();
-    assert!(
-        lg.status.success(),
-        "liggghts failed: {}",
-        String::from_utf8_lossy(&lg.stdout)
-    );
-    eprintln!(
-        "LIGGGHTS: {:.1} s for import_heated_drum (one revolution to t0, two dumped)",
-        started.elapsed().as_secs_f64()
-    );
+    run_liggghts(&case, run_dir, &["--dumps", "10", "1", "--per-proc"]);
     let (run, extra) = (run_dir.join("run.mcap"), run_dir.join("extra.mcap"));
     let path = |name: &str| run_dir.join(name).to_string_lossy().into_owned();
     let imported = tdex_ok(&[

@@ -135,17 +135,10 @@ fn the_replay_heats_the_bed_through_the_imported_wall_rows() {
     let o = import(dir.path(), Some("dump_walls.txt"), &run);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let extra = dir.path().join("extra.mcap");
-    let x = run_tdex(&[
-        "extrapolate",
-        run.to_str().unwrap(),
-        "--periods",
-        "1",
-        "-o",
-        extra.to_str().unwrap(),
-    ]);
-    assert!(x.status.success(), "{}", String::from_utf8_lossy(&x.stderr));
-    let i = run_tdex(&["inspect", extra.to_str().unwrap(), "--json"]);
-    let v: serde_json::Value = serde_json::from_slice(&i.stdout).unwrap();
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    tdex_ok(&["extrapolate", run_s, "--periods", "1", "-o", extra_s]);
+    let v: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["inspect", extra_s, "--json"])).unwrap();
     let wall_heat = v["wall_heat"].as_f64().expect("a wall heat");
     let gained = v["total_heat_end"].as_f64().unwrap() - v["total_heat_start"].as_f64().unwrap();
     assert!(
