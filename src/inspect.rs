@@ -188,8 +188,9 @@ struct Inspection {
     suggested_n_unconstrained: Option<u64>,
     max_cfl: Option<CflRow>,
     /// With a heated mantle: the heat it gave the bed over the first recorded period, in the
-    /// DEM and from the period's table replayed on the `t0` temperatures (`null` with
-    /// adiabatic walls).
+    /// DEM and from the period's table replayed on the `t0` temperatures (absent with
+    /// adiabatic walls, so that their JSON is as before).
+    #[serde(skip_serializing_if = "Option::is_none")]
     recorded_wall_heat: Option<RecordedWallHeat>,
     snapshots: Vec<SnapshotSummary>,
     costs: Option<RecordingCosts>,
