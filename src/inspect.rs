@@ -5,7 +5,9 @@
 use crate::cli::InspectPlan;
 use crate::fmt;
 use anyhow::Result;
-use extrapolate::replay::{self, Bodies, CflRow, Exchanges, RoleTemperatures, Scheme, SyncScratch};
+use extrapolate::replay::{
+    self, Bodies, CflRow, Exchange, Exchanges, RoleTemperatures, Scheme, SyncScratch,
+};
 use serde::Serialize;
 use tdex_format::extrapolation::Roles;
 use tdex_format::{
@@ -462,22 +464,25 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
     })?;
     let (mut wall_rows, mut contact_steps) = (0u64, 0u64);
     let mut period_rows = vec![0u64; info.recorded_periods as usize];
-    let found = replay::scan(reader, &Bodies::of(&info, t0), |r, _| {
+    let bodies = Bodies::of(&info, t0);
+    // with a heated mantle the first period is replayed from t0 in the same pass
+    let mut wall_heat = (conducting_walls(&info) > 0).then(|| WallHeatReplay::new(t0, &bodies));
+    let found = replay::scan(reader, &bodies, |r, exchange| {
         wall_rows += (r.j >= info.particles) as u64;
         contact_steps += r.duration_steps as u64;
         let period = info.period_of_step(r.start_step) as usize;
         if let Some(rows) = period_rows.get_mut(period) {
             *rows += 1;
         }
+        if let Some(replay) = wall_heat.as_mut().filter(|_| period == 0) {
+            replay.push(exchange, r.start_step as u32);
+        }
     })?;
     if info.recorded_periods == 1 {
         period_rows.clear();
     }
-    let recorded_wall_heat = if conducting_walls(&info) > 0 {
-        recorded_wall_heat(reader, &info, &snapshots, t0)?
-    } else {
-        None
-    };
+    let t1 = snapshots.iter().find(|s| s.index == 1);
+    let recorded_wall_heat = wall_heat.zip(t1).map(|(replay, t1)| replay.finish(t0, t1));
     let summary = reader.summary().cloned();
     let n = info.sample_every as u64;
     let histogram: Vec<HistogramBin> = summary.as_ref().map_or_else(Vec::new, |s| {
@@ -551,38 +556,61 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
     emit(plan.json, &inspection, print_human)
 }
 
-/// The wall's heat over the first recorded period, in the DEM and replayed from `t0` (see
-/// [`RecordedWallHeat`]); `None` without a snapshot at `t1`.
-fn recorded_wall_heat(
-    reader: &RecordingReader,
-    info: &tdex_format::RecordingInfo,
-    snapshots: &[Snapshot],
-    t0: &Snapshot,
-) -> Result<Option<RecordedWallHeat>> {
-    let Some(t1) = snapshots.iter().find(|s| s.index == 1) else {
-        return Ok(None);
-    };
-    let bodies = Bodies::of(info, t0);
-    // snapshots list the particles in id order, and at t0 particle k plays role k
-    let mut roles = RoleTemperatures::new(&t0.temp, &bodies);
-    let mut scratch = SyncScratch::default();
-    let mut rows = Exchanges::with_room_for(0);
-    for batch in reader.period_table(0) {
-        rows.clear();
-        for row in &batch?.rows {
-            rows.push_row(row, info, 0);
+/// The first recorded period's rows applied, as the scan hands them over, to the `t0`
+/// temperatures with the explicit scheme (at `t0` particle k plays role k): the wall's heat
+/// over the period as the table gives it ([`RecordedWallHeat`]).
+struct WallHeatReplay<'a> {
+    bodies: &'a Bodies,
+    roles: RoleTemperatures,
+    scratch: SyncScratch,
+    /// Rows waiting to be applied: a batch's worth at a time.
+    rows: Exchanges,
+}
+
+impl<'a> WallHeatReplay<'a> {
+    /// Rows applied at once; the scheme's result does not depend on it.
+    const BATCH: usize = 4096;
+
+    fn new(t0: &Snapshot, bodies: &'a Bodies) -> Self {
+        Self {
+            bodies,
+            roles: RoleTemperatures::new(&t0.temp, bodies),
+            scratch: SyncScratch::default(),
+            rows: Exchanges::with_room_for(Self::BATCH as u64),
         }
-        replay::apply_rows_with(&mut roles, &rows, &bodies, Scheme::Explicit, &mut scratch);
     }
-    scratch.flush(&mut roles);
-    let start = replay::total_heat(&t0.temp, &bodies);
-    let dem = replay::total_heat(&t1.temp, &bodies) - start;
-    let replayed = roles.total_heat(&bodies) - start;
-    Ok(Some(RecordedWallHeat {
-        dem,
-        replayed,
-        relative_difference: (replayed - dem) / dem,
-    }))
+
+    fn push(&mut self, exchange: Exchange, start_step: u32) {
+        self.rows.push(exchange, start_step);
+        if self.rows.len() == Self::BATCH {
+            self.apply();
+        }
+    }
+
+    fn apply(&mut self) {
+        let (bodies, scratch) = (self.bodies, &mut self.scratch);
+        replay::apply_rows_with(
+            &mut self.roles,
+            &self.rows,
+            bodies,
+            Scheme::Explicit,
+            scratch,
+        );
+        self.rows.clear();
+    }
+
+    fn finish(mut self, t0: &Snapshot, t1: &Snapshot) -> RecordedWallHeat {
+        self.apply();
+        self.scratch.flush(&mut self.roles);
+        let start = replay::total_heat(&t0.temp, self.bodies);
+        let dem = replay::total_heat(&t1.temp, self.bodies) - start;
+        let replayed = self.roles.total_heat(self.bodies) - start;
+        RecordedWallHeat {
+            dem,
+            replayed,
+            relative_difference: (replayed - dem) / dem,
+        }
+    }
 }
 
 fn print_human(s: &Inspection) {
