@@ -180,10 +180,10 @@ pub fn import(
     // for steps k … k + n − 1 of the period, so the samples are the dumps t0 + n … t1
     let (mut pairs, mut walls, mut merged) = (Vec::new(), Vec::new(), 0u64);
     for s in (step_t0 + every..=step_t1).step_by(every as usize) {
-        let parts = pair_frames.frame_at(s, &grid, opts.period_steps)?;
+        let parts = pair_frames.frame_at(s, &grid)?;
         contacts.sample(&parts, &mut pairs)?;
         if let Some((frames, wall)) = &mut wall_frames {
-            let parts = frames.frame_at(s, &grid, opts.period_steps)?;
+            let parts = frames.frame_at(s, &grid)?;
             merged += wall.sample(&parts, &mut walls)?;
             // rows that start at one sample keep the order of (i, j), walls after pairs
             // of the same particle: j = particles + wall
@@ -250,7 +250,6 @@ impl SampledFrames {
         &mut self,
         expected: u64,
         grid: &SampleGrid,
-        period_steps: u64,
     ) -> Result<Vec<FramePart>, ImportError> {
         loop {
             let next = self.set.next_timestep();
@@ -278,6 +277,7 @@ impl SampledFrames {
                         (None, None) => format!("no {what} dump follows t0"),
                     };
                     let (step_t0, step_t1, every) = (grid.step_t0, grid.step_t1, grid.every);
+                    let period_steps = step_t1 - step_t0;
                     return Err(ImportError::Inconsistent(format!(
                         "{}: no {what} dump at timestep {expected} (t0 = {step_t0} + {} steps): \
                          the period τ = {period_steps} steps from t0 needs one every n = \
