@@ -89,14 +89,21 @@ fn import(dir: &Path, walls: Option<&str>, out: &Path) -> std::process::Output {
     run_tdex(&args.iter().map(String::as_str).collect::<Vec<_>>())
 }
 
-#[test]
-fn wall_contacts_become_one_wall_row_per_particle_and_sample() {
+/// The heated inputs written in a fresh folder and imported with their wall dumps into
+/// `run.mcap` there: the folder, the recording and the import's JSON summary.
+fn import_heated() -> (tempfile::TempDir, std::path::PathBuf, serde_json::Value) {
     let dir = tempfile::tempdir().unwrap();
     write_inputs(dir.path(), true);
     let out = dir.path().join("run.mcap");
     let o = import(dir.path(), Some("dump_walls.txt"), &out);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let summary: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let summary = serde_json::from_slice(&o.stdout).unwrap();
+    (dir, out, summary)
+}
+
+#[test]
+fn wall_contacts_become_one_wall_row_per_particle_and_sample() {
+    let (_dir, out, summary) = import_heated();
     assert_eq!(summary["wall_frames"], 3);
     assert_eq!(summary["wall_contacts_merged"], 1, "{summary}");
 
@@ -129,11 +136,7 @@ fn wall_contacts_become_one_wall_row_per_particle_and_sample() {
 
 #[test]
 fn the_replay_heats_the_bed_through_the_imported_wall_rows() {
-    let dir = tempfile::tempdir().unwrap();
-    write_inputs(dir.path(), true);
-    let run = dir.path().join("run.mcap");
-    let o = import(dir.path(), Some("dump_walls.txt"), &run);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (dir, run, _) = import_heated();
     let extra = dir.path().join("extra.mcap");
     let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
     tdex_ok(&["extrapolate", run_s, "--periods", "1", "-o", extra_s]);
