@@ -7,6 +7,7 @@ mod cli_bench;
 mod cli_case_errors;
 mod cli_checkpoint;
 mod cli_compare;
+mod cli_draws;
 mod cli_export;
 mod cli_extrapolate;
 mod cli_import;

@@ -259,6 +259,18 @@ pub struct CompareArgs {
     /// measure the DEM's run-to-run spread. Repeatable.
     #[arg(long = "dem-run", value_name = "RECORDING")]
     pub dem_runs: Vec<PathBuf>,
+    /// A further draw of the same case: another recording (another seed, another recorded
+    /// window, with --twins 2 or more) and its extrapolation, judged as the first pair is.
+    /// With one or more, a pooled verdict over all the draws follows: the mean median ratio
+    /// and the share of t_k outside the DEM runs' range, ± their standard errors, beside a
+    /// DEM run's judged in the same seat. Repeatable.
+    #[arg(
+        long = "draw",
+        num_args = 2,
+        value_names = ["RECORDING", "EXTRAPOLATION"],
+        conflicts_with_all = ["csv", "dem_runs"]
+    )]
+    pub draws: Vec<PathBuf>,
 }
 
 /// `tdex report`.
@@ -505,7 +517,8 @@ pub enum StudyCommand {
     /// over the reference periods against the DEM and its twins (median ratio to their
     /// spread, the t_k outside their range) beside what recording P periods costs. CASE may
     /// also be a recording made with `tdex record --recorded-periods P --reference K --twins M`
-    /// (for long DEM runs: record it in the background with `--checkpoint-every`).
+    /// (for long DEM runs: record it in the background with `--checkpoint-every`); several
+    /// recordings of the case give a pooled verdict per P over them.
     Horizon(HorizonStudyArgs),
 }
 
@@ -576,6 +589,11 @@ pub struct PeriodStudyArgs {
 pub struct HorizonStudyArgs {
     #[command(flatten)]
     pub common: StudyCommon,
+    /// Further recordings of the same case (another seed, another recorded window), each
+    /// with --twins 2 or more, when CASE is a recording too: every P runs on each of them,
+    /// and a pooled verdict over these draws follows per P.
+    #[arg(value_name = "RECORDING")]
+    pub draws: Vec<PathBuf>,
     /// Numbers of recorded periods P to compare, comma-separated. The DEM runs once and
     /// records the largest; a smaller P replays the first P of its periods (the tables and
     /// snapshots a recording of P periods holds).

@@ -114,6 +114,9 @@ pub enum StudyKind {
     /// reference periods.
     Horizon {
         source: HorizonSource,
+        /// Further recordings of the case, each a draw of the pooled verdict (empty: one
+        /// recording, no pooled verdict).
+        draws: Vec<PathBuf>,
         /// Distinct, ascending.
         recorded_periods: Vec<u32>,
         /// The recurrence paths' seed; `None`: the case's.
@@ -156,6 +159,9 @@ pub struct ComparePlan {
     pub extrapolation: PathBuf,
     /// Further DEM runs of the case for the floor (`--dem-run`).
     pub dem_runs: Vec<PathBuf>,
+    /// Further draws of the case, (recording, extrapolation), for a pooled verdict
+    /// (`--draw`).
+    pub draws: Vec<(PathBuf, PathBuf)>,
     pub cells: usize,
     pub seed: u64,
     pub json: bool,
@@ -448,6 +454,12 @@ impl ComparePlan {
             recording: args.recording,
             extrapolation: args.extrapolation,
             dem_runs: args.dem_runs,
+            // clap takes two values per --draw
+            draws: args
+                .draws
+                .chunks_exact(2)
+                .map(|pair| (pair[0].clone(), pair[1].clone()))
+                .collect(),
             cells: args.cells,
             seed: args.seed,
             json: args.json,
@@ -764,6 +776,60 @@ impl StudyPlan {
     }
 }
 
+/// The further recordings of `tdex study horizon`, each a draw of the pooled verdict beside
+/// the first recording `first` (at `first_path`): every one a recording of the same case
+/// that holds the `most` recorded periods asked for, and every one (the first too) with
+/// the 3 DEM runs a DEM run judged in the extrapolation's seat needs.
+fn check_horizon_draws(
+    first_path: &std::path::Path,
+    first: &RecordingReader,
+    draws: &[PathBuf],
+    most: u32,
+) -> Result<()> {
+    use crate::compare::draws::{check_same_case, MIN_DEM_RUNS};
+    if draws.is_empty() {
+        return Ok(());
+    }
+    let first_name = first_path.display().to_string();
+    let runs = |path: &std::path::Path, r: &RecordingReader| {
+        let dem_runs = 1 + r.info().twins as usize;
+        if dem_runs < MIN_DEM_RUNS {
+            return Err(usage(format!(
+                "{}: has {} DEM twin(s); a pooled verdict over several recordings judges each \
+                 DEM run in the extrapolation's seat against the others, which takes at least \
+                 2 twins: record it with --twins 2",
+                path.display(),
+                r.info().twins
+            )));
+        }
+        Ok(())
+    };
+    runs(first_path, first)?;
+    for path in draws {
+        if !is_recording(path) {
+            return Err(usage(format!(
+                "{}: not a recording; several inputs are allowed only if all are recordings \
+                 (the draws of a pooled verdict)",
+                path.display()
+            )));
+        }
+        let r = RecordingReader::open(path)?;
+        check_same_case(
+            (&first_name, first.info()),
+            (&path.display().to_string(), r.info()),
+        )?;
+        runs(path, &r)?;
+        if most > r.info().recorded_periods {
+            return Err(usage(format!(
+                "--recorded-periods {most}: {} holds {} recorded period(s); record it with --recorded-periods {most}",
+                path.display(),
+                r.info().recorded_periods
+            )));
+        }
+    }
+    Ok(())
+}
+
 impl StudyKind {
     /// Every `(n, Δt_c^max)` of the lists with Δt_c^max a multiple of n, checked against the
     /// case; the others are skipped.
@@ -848,6 +914,7 @@ impl StudyKind {
     ) -> Result<Self> {
         let HorizonStudyArgs {
             common,
+            draws,
             recorded_periods,
             reference,
             twins,
@@ -885,7 +952,16 @@ impl StudyKind {
                         common.case.display()
                     )));
                 }
+                check_horizon_draws(&common.case, r, &draws, most)?;
                 HorizonSource::Recording(common.case.clone())
+            }
+            None if !draws.is_empty() => {
+                return Err(usage(format!(
+                    "{}: a case file, given with {} further input(s); several inputs are \
+                     allowed only if all are recordings (the draws of a pooled verdict)",
+                    common.case.display(),
+                    draws.len()
+                )));
             }
             None => {
                 let mut options = record_options(
@@ -907,6 +983,7 @@ impl StudyKind {
         };
         Ok(StudyKind::Horizon {
             source,
+            draws,
             recorded_periods,
             seed,
             images,

@@ -26,6 +26,10 @@ pub struct Floor {
     /// yardstick's own scatter: what a genuine run scores in the second field's seat, with
     /// one run fewer to be judged against.
     pub runs_ratio_to_others: Vec<Option<f64>>,
+    /// Each DEM run (in the order given) placed as the second field is in
+    /// [`within`]: whether its mean `ε_abs` to the other runs exceeds the largest distance
+    /// between two of them. Empty with fewer than three runs, as `runs_ratio_to_others`.
+    pub runs_outside_others_range: Vec<bool>,
 }
 
 /// Whether an extrapolation is within the DEM runs' own range at one `t_k`: its mean distance
@@ -145,8 +149,10 @@ pub fn floor(
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let floor_eps_abs = mean(&pairs);
     let eps_abs_to_dem_runs = mean(&to_runs);
-    let runs_ratio_to_others = if n < 3 {
-        Vec::new()
+    // each run in the second field's seat: its mean distance to the others, over their mean
+    // distance to each other (the ratio) and against their largest (the range)
+    let (runs_ratio_to_others, runs_outside_others_range) = if n < 3 {
+        (Vec::new(), Vec::new())
     } else {
         (0..n)
             .map(|c| {
@@ -158,9 +164,14 @@ pub fn floor(
                     .map(|(a, b)| distance[a][b])
                     .collect();
                 let floor = mean(&among);
-                (floor > 0.0).then(|| mean(&to_others) / floor)
+                let max = among.iter().copied().fold(0.0, f64::max);
+                let to_others = mean(&to_others);
+                (
+                    (floor > 0.0).then(|| to_others / floor),
+                    !within(to_others, max),
+                )
             })
-            .collect()
+            .unzip()
     };
     Some(Floor {
         floor_eps_abs,
@@ -170,6 +181,7 @@ pub fn floor(
         eps_abs_to_dem_runs,
         ratio_to_floor: (floor_eps_abs > 0.0).then(|| eps_abs_to_dem_runs / floor_eps_abs),
         runs_ratio_to_others,
+        runs_outside_others_range,
     })
 }
 
@@ -353,12 +365,16 @@ mod tests {
             f.runs_ratio_to_others,
             vec![Some(3.0 / 4.0), Some(2.5 / 5.0), Some(4.5)]
         );
+        // and placed against the others' range as the second field is: run 0 (3) and run 1
+        // (2.5) are within the other pair's distance (4, 5), run 2 (4.5) is beyond 1
+        assert_eq!(f.runs_outside_others_range, vec![false, false, true]);
         // the floor and the second field's ratio are those of all three runs
         assert_eq!(f.floor_eps_abs, 10.0 / 3.0);
         assert_eq!(f.eps_abs_to_dem_runs, 2.0);
         // two runs: neither has a floor of others to be judged against
         let two = floor(&cells(), &runs[..2], &on_first, Departure::WithTheTwins).unwrap();
         assert!(two.runs_ratio_to_others.is_empty());
+        assert!(two.runs_outside_others_range.is_empty());
         // identical others give no ratio, not an infinite one
         let same = [temps[0], temps[0], temps[1]];
         let runs: Vec<Field> = same.iter().map(|t| Field { pos: &POS, temp: t }).collect();

@@ -2,6 +2,7 @@
 //! §7): Voronoi-cell errors, the Eq. 10 energy-transfer error, hot/cold group means. The
 //! same measures between two DEM runs of one case give the floor no extrapolation can beat.
 
+pub mod draws;
 pub mod floor;
 pub mod metrics;
 pub mod verdict;
@@ -115,6 +116,11 @@ pub struct PeriodComparison {
     /// others are identical).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_ratio_to_others: Vec<Option<f64>>,
+    /// Each DEM run, in the same order, placed as the second field is in `outside_range`:
+    /// whether its mean `ε_abs` to the others exceeds the largest distance between two of
+    /// them (empty with fewer than three runs, and then left out of the JSON).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dem_runs_outside_others_range: Vec<bool>,
     /// Eq. 10 of each further DEM run against the reference, the largest in magnitude.
     pub floor_energy_error: Option<f64>,
     /// Group and bed means of the further DEM runs at this `t_k` (twins first).
@@ -220,6 +226,35 @@ pub enum CompareError {
         recording: String,
         time: f64,
         half_step: f64,
+    },
+    #[error(
+        "a pooled verdict is over at least 2 draws, and {draws} was given: over one, the \
+         verdict of `tdex compare RECORDING EXTRAPOLATION` is the judgement"
+    )]
+    TooFewDraws { draws: usize },
+    #[error(
+        "{draw} is not a draw of the case of {first}: {what}; the draws of a pooled verdict \
+         are recordings of one case (another seed, or another recorded window)"
+    )]
+    OtherCase {
+        draw: String,
+        first: String,
+        what: String,
+    },
+    #[error(
+        "{recording} has {dem_runs} DEM run(s) (the reference and its twins): a pooled verdict \
+         judges each DEM run in the extrapolation's seat against the others, which takes at \
+         least 3; record it with --twins 2"
+    )]
+    DrawTooFewRuns { recording: String, dem_runs: usize },
+    #[error(
+        "{extrapolation} against {recording} has no median ratio for itself or for the DEM \
+         runs in its seat, so it cannot be pooled (its verdict: {verdict})"
+    )]
+    DrawNotJudged {
+        extrapolation: String,
+        recording: String,
+        verdict: String,
     },
 }
 
@@ -529,6 +564,9 @@ pub fn compare_runs(
             dem_runs_ratio_to_others: floor
                 .as_ref()
                 .map_or_else(Vec::new, |f| f.runs_ratio_to_others.clone()),
+            dem_runs_outside_others_range: floor
+                .as_ref()
+                .map_or_else(Vec::new, |f| f.runs_outside_others_range.clone()),
             floor_energy_error,
             dem_runs_hot_mean: at_k
                 .iter()

@@ -35,6 +35,12 @@ pub struct Verdict {
     /// where a genuine run lands on this bar.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_median_ratio: Vec<f64>,
+    /// Each DEM run's share of the compared `t_k` (0 to 1) where it is farther from the other
+    /// runs than the two farthest of them are from each other: the second field's
+    /// `outside_range` over `compared`, for a genuine run in its seat. Over the same `t_k` as
+    /// `dem_runs_median_ratio`, and empty (left out of the JSON) when it is.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dem_runs_outside_share: Vec<f64>,
     /// The verdict in words.
     pub text: String,
 }
@@ -86,7 +92,7 @@ fn above_one(x: f64) -> String {
 }
 
 /// A temperature difference in K with a precision fit for it.
-fn kelvin(x: f64) -> String {
+pub(crate) fn kelvin(x: f64) -> String {
     let digits = if x == 0.0 {
         0
     } else {
@@ -189,15 +195,39 @@ impl Verdict {
         }
         let median_ratio = median(&ratios);
         let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs);
-        // the yardstick beside the median: how the DEM runs themselves score on it
+        let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
+            Vec::new()
+        } else {
+            runs_outside_shares(&periods, &compared, dem_runs)
+        };
+        // the yardstick beside the median: how the DEM runs themselves score on it, and how
+        // often each is beyond the others' range
         let yardstick = match (median_ratio, dem_runs_median_ratio.as_slice()) {
             (Some(m), runs) if !runs.is_empty() => {
                 let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
                 let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 let above = runs.iter().filter(|&&r| r > m).count();
+                let n = compared.len();
+                let counts: Vec<usize> = dem_runs_outside_share
+                    .iter()
+                    .map(|share| (share * n as f64).round() as usize)
+                    .collect();
+                let beyond = match (counts.iter().min(), counts.iter().max()) {
+                    (Some(lo), Some(hi)) => format!(
+                        "; farther from the others than their farthest two at {} of the {n} \
+                         compared t_k (the extrapolation: {})",
+                        if lo == hi {
+                            lo.to_string()
+                        } else {
+                            format!("{lo}–{hi}")
+                        },
+                        outside_range.len()
+                    ),
+                    _ => String::new(),
+                };
                 format!(
                     "; each DEM run judged the same way against the others: medians {}–{}, {above} of the \
-                     {} above the extrapolation's",
+                     {} above the extrapolation's{beyond}",
                     num(lo),
                     num(hi),
                     runs.len()
@@ -335,8 +365,16 @@ impl Verdict {
             means_error_max: error,
             means_spread_max: spread,
             dem_runs_median_ratio,
+            dem_runs_outside_share,
             text,
         }
+    }
+
+    /// The share of the compared `t_k` (0 to 1) where the second field is outside the DEM
+    /// runs' range; `None` where none was compared.
+    pub fn outside_share(&self) -> Option<f64> {
+        (!self.compared.is_empty())
+            .then(|| self.outside_range.len() as f64 / self.compared.len() as f64)
     }
 }
 
@@ -361,6 +399,47 @@ fn runs_medians(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize
         })
         .collect::<Option<Vec<f64>>>()
         .unwrap_or_default()
+}
+
+/// Each DEM run's share of the `compared` `t_k` where [`PeriodComparison::
+/// dem_runs_outside_others_range`] holds: its `outside_range` over `compared`, as the second
+/// field's. Empty unless all `dem_runs` ≥ 3 runs were judged (had a ratio) at every compared
+/// `t_k`, the condition of [`runs_medians`], so that both are over the same instants.
+fn runs_outside_shares(
+    periods: &[&PeriodComparison],
+    compared: &[u32],
+    dem_runs: usize,
+) -> Vec<f64> {
+    if dem_runs < 3 || compared.is_empty() {
+        return Vec::new();
+    }
+    let at: Vec<&PeriodComparison> = periods
+        .iter()
+        .filter(|p| compared.contains(&p.k))
+        .copied()
+        .collect();
+    let judged = at.iter().all(|p| {
+        p.dem_runs_outside_others_range.len() == dem_runs
+            && (0..dem_runs).all(|run| {
+                p.dem_runs_ratio_to_others
+                    .get(run)
+                    .copied()
+                    .flatten()
+                    .is_some()
+            })
+    });
+    if !judged {
+        return Vec::new();
+    }
+    (0..dem_runs)
+        .map(|run| {
+            let outside = at
+                .iter()
+                .filter(|p| p.dem_runs_outside_others_range[run])
+                .count();
+            outside as f64 / at.len() as f64
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -392,6 +471,7 @@ mod tests {
             eps_abs_to_dem_runs: Some(ratio * floor),
             ratio_to_floor: Some(ratio),
             dem_runs_ratio_to_others: Vec::new(),
+            dem_runs_outside_others_range: Vec::new(),
             floor_energy_error: None,
             dem_runs_hot_mean: vec![310.04],
             dem_runs_cold_mean: vec![300.01],
@@ -501,6 +581,8 @@ mod tests {
             .collect();
         for (p, straggler) in periods.iter_mut().zip([1.2, 1.4, 1.3, 1.3, 1.5, 1.1]) {
             p.dem_runs_ratio_to_others = vec![Some(0.8), Some(0.9), Some(1.0), Some(straggler)];
+            // the straggler beyond the others' range where its ratio is above 1.25
+            p.dem_runs_outside_others_range = vec![false, false, false, straggler > 1.25];
         }
         let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio, vec![0.8, 0.9, 1.0, 1.3]);
@@ -510,15 +592,30 @@ mod tests {
             "{}",
             v.text
         );
+        // the straggler is beyond the others at 4 of the 6 t_k, the others never; the
+        // extrapolation never beyond the runs' range (spread 1.5 above its ratios)
+        assert_eq!(v.dem_runs_outside_share, vec![0.0, 0.0, 0.0, 4.0 / 6.0]);
+        assert_eq!(v.outside_share(), Some(0.0));
+        assert!(
+            v.text.contains(
+                "farther from the others than their farthest two at 0–4 of the 6 compared t_k \
+                 (the extrapolation: 0)"
+            ),
+            "{}",
+            v.text
+        );
         // the recorded stretch is left out of the runs' medians as of the extrapolation's
         periods[0].within_recording = true;
         periods[0].dem_runs_ratio_to_others[3] = Some(9.0);
         let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert_eq!(v.dem_runs_median_ratio[3], 1.3);
+        // t2 (the straggler's 1.2, within) left out: 4 of the 5 compared t_k
+        assert_eq!(v.dem_runs_outside_share[3], 4.0 / 5.0);
         // a run missing at one compared t_k: no medians, and nothing said
         periods[2].dem_runs_ratio_to_others.pop();
         let v = Verdict::of(&periods, 4, Departure::WithTheTwins, ContrastKind::HotCold);
         assert!(v.dem_runs_median_ratio.is_empty());
+        assert!(v.dem_runs_outside_share.is_empty());
         assert!(!v.text.contains("each DEM run"), "{}", v.text);
     }
 

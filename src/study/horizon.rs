@@ -7,16 +7,22 @@
 //! recording of P periods would hold (the recorder only reads the DEM's state), so every P
 //! is judged against the same DEM run and the same twins. With `--mirror` each P runs twice,
 //! as the paper does and with the drum's mirror image at every jump, on the same paths.
+//!
+//! Given several recordings of the case (draws: other seeds, other recorded windows), every
+//! P runs on each, and a pooled verdict per P ([`crate::compare::draws`]) weighs the mean
+//! median ratio over the draws against a DEM run's judged in the same seat: one recording's
+//! median ratio is too noisy a figure to settle whether P passes as one more DEM run.
 
 use super::plots::{self, Line, LineKind};
 use crate::cli::{HorizonSource, StudyPlan};
+use crate::compare::draws::{self, Draw, Draws};
 use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
 use extrapolate::{ExtrapolationRequest, MirrorCheck};
 use recorder::record;
 use serde::Serialize;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use tdex_format::extrapolation::Symmetry;
 use tdex_format::{ExtrapolationReader, RecordingCosts, RecordingReader};
 
@@ -27,6 +33,13 @@ struct Entry {
     recorded_periods: u32,
     /// `none` (the paper's method) or `axial_mirror`.
     symmetry: Symmetry,
+    /// The recording of this draw, with several (left out with one, whose recording is the
+    /// study's).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    recording: Option<String>,
+    /// The draw's name in the outputs (the recording's stem), with several.
+    #[serde(skip)]
+    draw: Option<String>,
     /// With the mirror: each start's mirrored pairing beside its plain one.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     mirror_check: Vec<MirrorCheck>,
@@ -66,11 +79,64 @@ struct HorizonStudy {
     /// The seed of the recurrence paths (null: the case's seed, the default).
     path_seed: Option<u64>,
     runs: Vec<Entry>,
+    /// With several recordings: each draw's recording (the study's first), and per P (and
+    /// image) the pooled verdict over them; both left out with one recording.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    draws: Vec<String>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pooled: Vec<PooledRun>,
+}
+
+/// One number of recorded periods with one image, judged over every draw.
+#[derive(Debug, Serialize)]
+struct PooledRun {
+    recorded_periods: u32,
+    symmetry: Symmetry,
+    #[serde(flatten)]
+    draws: Draws,
+}
+
+impl PooledRun {
+    fn label(&self) -> String {
+        label(self.recorded_periods, self.symmetry)
+    }
+}
+
+/// `P = 2`, or `P = 2, mirror`: a configuration's name in the table and the plots.
+fn label(p: u32, symmetry: Symmetry) -> String {
+    match symmetry {
+        Symmetry::None => format!("P = {p}"),
+        Symmetry::AxialMirror => format!("P = {p}, mirror"),
+    }
+}
+
+/// Each recording's name as a draw (its file stem), made distinct by its place where two
+/// share a stem.
+fn draw_names(recordings: &[PathBuf]) -> Vec<String> {
+    let stems: Vec<String> = recordings
+        .iter()
+        .map(|r| {
+            r.file_stem()
+                .map_or_else(|| "draw".to_string(), |s| s.to_string_lossy().into_owned())
+        })
+        .collect();
+    stems
+        .iter()
+        .enumerate()
+        .map(|(i, stem)| {
+            if stems.iter().filter(|s| *s == stem).count() > 1 {
+                format!("{stem}_{}", i + 1)
+            } else {
+                stem.clone()
+            }
+        })
+        .collect()
 }
 
 pub fn run(
     plan: &StudyPlan,
     source: &HorizonSource,
+    draws: &[PathBuf],
     recorded_periods: &[u32],
     seed: Option<u64>,
     images: &[Symmetry],
@@ -103,55 +169,61 @@ pub fn run(
             path
         }
     };
-    let rec = RecordingReader::open(&recording)?;
-    let info = rec.info().clone();
-    if let Some(&p) = recorded_periods
+    let recordings: Vec<PathBuf> = std::iter::once(recording.clone())
+        .chain(draws.iter().cloned())
+        .collect();
+    let several = recordings.len() > 1;
+    let names = draw_names(&recordings);
+    let configurations: Vec<(u32, Symmetry)> = recorded_periods
         .iter()
-        .find(|&&p| p > info.recorded_periods)
-    {
-        bail!(
-            "{}: holds {} recorded period(s); --recorded-periods {p} cannot be replayed from it",
-            recording.display(),
-            info.recorded_periods
-        );
+        .flat_map(|&p| images.iter().map(move |&s| (p, s)))
+        .collect();
+    // per draw, every configuration in order
+    let mut by_draw: Vec<Vec<Entry>> = Vec::with_capacity(recordings.len());
+    let mut info = None;
+    for (path, name) in recordings.iter().zip(&names) {
+        let rec = RecordingReader::open(path)?;
+        let held = rec.info().recorded_periods;
+        if let Some(&p) = recorded_periods.iter().find(|&&p| p > held) {
+            bail!(
+                "{}: holds {held} recorded period(s); --recorded-periods {p} cannot be replayed \
+                 from it",
+                path.display(),
+            );
+        }
+        // with one recording the files keep their names; with several each draw's name
+        // ends them
+        let draw = several.then_some(name.as_str());
+        let mut entries = Vec::with_capacity(configurations.len());
+        for &(p, symmetry) in &configurations {
+            entries.push(run_one(plan, &rec, path, draw, p, symmetry, seed)?);
+        }
+        info.get_or_insert_with(|| rec.info().clone());
+        by_draw.push(entries);
     }
+    let info = info.expect("one recording at least");
+    // the table's order: configuration by configuration, the draws of each together
+    let mut by_draw: Vec<std::vec::IntoIter<Entry>> =
+        by_draw.into_iter().map(Vec::into_iter).collect();
     let mut runs = Vec::new();
-    for (&p, &symmetry) in recorded_periods
-        .iter()
-        .flat_map(|p| images.iter().map(move |s| (p, s)))
-    {
-        let extra = dir.join(match symmetry {
-            Symmetry::None => format!("horizon_p{p}.extra.mcap"),
-            Symmetry::AxialMirror => format!("horizon_p{p}_mirror.extra.mcap"),
-        });
-        let request = ExtrapolationRequest {
-            recorded_periods: Some(p),
-            path_seed: seed,
-            symmetry,
-            ..ExtrapolationRequest::new(
-                recording.clone(),
-                info.reference_periods,
-                extra.clone(),
-                extrapolation::memory_limit(None),
-            )
-        };
-        let outcome = crate::with_workers(plan.threads, || {
-            Ok(extrapolate::extrapolate_recording(
-                &request,
-                extrapolation::tell,
-            )?)
-        })
-        .with_context(|| format!("extrapolating with {p} recorded period(s)"))?;
-        let ext = ExtrapolationReader::open(&extra)?;
-        let comparison = compare::compare(&rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
-        runs.push(Entry::new(
-            p,
-            symmetry,
-            outcome.mirror_check,
-            &extra,
-            rec.costs(),
-            comparison,
-        ));
+    let mut pooled = Vec::new();
+    for &(p, symmetry) in &configurations {
+        let entries: Vec<Entry> = by_draw
+            .iter_mut()
+            .map(|d| d.next().expect("one entry per configuration"))
+            .collect();
+        if several {
+            let each = entries
+                .iter()
+                .map(|e| Draw::of(&e.comparison))
+                .collect::<Result<Vec<_>, _>>()?;
+            pooled.push(PooledRun {
+                recorded_periods: p,
+                symmetry,
+                draws: Draws::pool(each)?,
+            });
+        }
+        runs.extend(entries);
     }
     let study = HorizonStudy {
         study: "horizon",
@@ -164,6 +236,12 @@ pub fn run(
         tau: info.tau,
         path_seed: seed,
         runs,
+        draws: if several {
+            recordings.iter().map(|r| r.display().to_string()).collect()
+        } else {
+            Vec::new()
+        },
+        pooled,
     };
     let table = table(&study);
     super::finish(
@@ -173,6 +251,64 @@ pub fn run(
         &markdown(&study, &table),
         svgs(&study)?,
     )
+}
+
+/// Extrapolates the first `p` recorded periods of `rec` (at `path`) with `symmetry` at the
+/// jumps over its reference periods and compares it with the DEM runs; `draw` names the
+/// recording in the file name and the outputs when there are several.
+fn run_one(
+    plan: &StudyPlan,
+    rec: &RecordingReader,
+    path: &Path,
+    draw: Option<&str>,
+    p: u32,
+    symmetry: Symmetry,
+    seed: Option<u64>,
+) -> Result<Entry> {
+    let image = match symmetry {
+        Symmetry::None => "",
+        Symmetry::AxialMirror => "_mirror",
+    };
+    let suffix = draw.map_or(String::new(), |d| format!("_{d}"));
+    let extra = plan
+        .output
+        .join(format!("horizon_p{p}{image}{suffix}.extra.mcap"));
+    let request = ExtrapolationRequest {
+        recorded_periods: Some(p),
+        path_seed: seed,
+        symmetry,
+        ..ExtrapolationRequest::new(
+            path.to_path_buf(),
+            rec.info().reference_periods,
+            extra.clone(),
+            extrapolation::memory_limit(None),
+        )
+    };
+    let outcome = crate::with_workers(plan.threads, || {
+        Ok(extrapolate::extrapolate_recording(
+            &request,
+            extrapolation::tell,
+        )?)
+    })
+    .with_context(|| match draw {
+        Some(d) => format!("extrapolating {d} with {p} recorded period(s)"),
+        None => format!("extrapolating with {p} recorded period(s)"),
+    })?;
+    let ext = ExtrapolationReader::open(&extra)?;
+    let comparison = compare::compare(rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
+    let mut entry = Entry::new(
+        p,
+        symmetry,
+        outcome.mirror_check,
+        &extra,
+        rec.costs(),
+        comparison,
+    );
+    if let Some(d) = draw {
+        entry.recording = Some(path.display().to_string());
+        entry.draw = Some(d.to_string());
+    }
+    Ok(entry)
 }
 
 /// DEM seconds to `t0` and through the first `p` recorded periods.
@@ -191,11 +327,13 @@ fn recording_seconds(costs: &RecordingCosts, p: u32) -> Option<f64> {
 }
 
 impl Entry {
-    /// `P = 2`, or `P = 2, mirror`: the run's name in the table and the plots.
+    /// `P = 2`, or `P = 2, mirror`, and the draw's name with several (`P = 2 (seed6)`): the
+    /// run's name in the table and the plots.
     fn label(&self) -> String {
-        match self.symmetry {
-            Symmetry::None => format!("P = {}", self.recorded_periods),
-            Symmetry::AxialMirror => format!("P = {}, mirror", self.recorded_periods),
+        let label = label(self.recorded_periods, self.symmetry);
+        match &self.draw {
+            Some(d) => format!("{label} ({d})"),
+            None => label,
         }
     }
 
@@ -212,6 +350,8 @@ impl Entry {
         Entry {
             recorded_periods: p,
             symmetry,
+            recording: None,
+            draw: None,
             mirror_check,
             extrapolation: extra.display().to_string(),
             recording_seconds: costs.and_then(|c| recording_seconds(c, p)),
@@ -237,8 +377,16 @@ fn opt(x: Option<f64>, digits: usize) -> String {
 
 fn table(s: &HorizonStudy) -> String {
     let last = s.reference_periods + 1;
+    // as wide as `P = 2, mirror`, wider for the draws' names
+    let w = s
+        .runs
+        .iter()
+        .map(|e| e.label().chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(13);
     let mut t = format!(
-        "{:<13} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
+        "{:<w$} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
         "run",
         "recording (s)",
         "median ratio",
@@ -249,7 +397,7 @@ fn table(s: &HorizonStudy) -> String {
     );
     for e in &s.runs {
         t += &format!(
-            "{:<13} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
+            "{:<w$} {:>14} {:>12} {:>13} {:>18} {:>22} {:>18}\n",
             e.label(),
             opt(e.recording_seconds, 1),
             opt(e.median_ratio, 2),
@@ -273,7 +421,9 @@ fn table(s: &HorizonStudy) -> String {
             t += &format!("{}: mirror check {line}\n", e.label());
         }
     }
-    if let Some(best) = s
+    if !s.pooled.is_empty() {
+        t += &pooled_table(s);
+    } else if let Some(best) = s
         .runs
         .iter()
         .filter(|e| e.median_ratio.is_some())
@@ -288,7 +438,76 @@ fn table(s: &HorizonStudy) -> String {
     t
 }
 
+/// With several recordings: per P (and image), the pooled figures over the draws (mean ±
+/// standard error), the extrapolation's beside a DEM run's judged in the same seat, then
+/// each pooled verdict and the P closest to one more DEM run over the draws.
+fn pooled_table(s: &HorizonStudy) -> String {
+    let mut t = format!(
+        "\npooled over the {} draws (mean ± standard error over them; beyond range: the share \
+         of compared t_k farther from the DEM runs than the two farthest of them):\n",
+        s.draws.len()
+    );
+    t += &format!(
+        "{:<13} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
+        "run",
+        "median ratio",
+        "beyond range",
+        "DEM run: median ratio",
+        "DEM run: beyond range",
+        "passes"
+    );
+    for r in &s.pooled {
+        let d = &r.draws;
+        t += &format!(
+            "{:<13} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
+            r.label(),
+            draws::plus_minus(d.median_ratio),
+            draws::percent_plus_minus(d.outside_share),
+            draws::plus_minus(d.dem_runs_median_ratio),
+            draws::percent_plus_minus(d.dem_runs_outside_share),
+            if d.passes { "yes" } else { "no" },
+        );
+    }
+    for r in &s.pooled {
+        t += &format!("{} over the draws: {}\n", r.label(), r.draws.text);
+    }
+    if let Some(best) = s.pooled.iter().min_by(|a, b| {
+        a.draws
+            .median_ratio
+            .mean
+            .total_cmp(&b.draws.median_ratio.mean)
+    }) {
+        t += &format!(
+            "closest to one more DEM run over the draws: {} (mean median ratio {})\n",
+            best.label(),
+            draws::plus_minus(best.draws.median_ratio)
+        );
+    }
+    t
+}
+
 fn markdown(s: &HorizonStudy, table: &str) -> String {
+    // with several recordings: what the rows and the pooled verdict are
+    let pooled = if s.draws.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "\n\nEvery row runs on each of the {} recordings of the case (the draws: {}), \
+             named after its file. Per P, the pooled verdict weighs the mean median ratio over \
+             the draws (± its standard error, the sample standard deviation over √n) against a \
+             DEM run's judged in the same seat against the other runs (per draw the mean of the \
+             runs' medians); it passes when that mean is at most the DEM runs' plus two \
+             standard errors of the difference, the share of t_k beyond the DEM runs' range at \
+             most theirs plus 10 points, and the group (or bed) means within the DEM runs' \
+             spread in every draw. The plot of the means shows the first draw.",
+            s.draws.len(),
+            s.draws
+                .iter()
+                .map(|d| format!("`{d}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )
+    };
     format!(
         "# Long-horizon study: {}\n\n{} particles, τ = {} s; the recording `{}` holds {} \
          recorded period(s), {} reference periods and {} DEM twin(s). Each row replays the \
@@ -300,7 +519,7 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
          it is farther from them than the two farthest DEM runs are from each other; means \
          error/spread: the largest error of the group (or bed) means against the largest \
          difference between two DEM runs' means; recording: DEM seconds to t0 and through the \
-         P recorded periods.\n\n```\n{table}```\n\n![ratio to the DEM's spread](ratio.svg)\n\n\
+         P recorded periods.{pooled}\n\n```\n{table}```\n\n![ratio to the DEM's spread](ratio.svg)\n\n\
          ![means](means.svg)\n",
         s.case,
         s.particles,
@@ -392,7 +611,14 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
             push_means(format!("DEM twin {}", m + 1), LineKind::DemRun, twin);
         }
     }
-    for (e, &kind) in s.runs.iter().zip(&kinds) {
+    // the DEM runs above are the first draw's: the extrapolations beside them too
+    let first_draw = s.runs.first().and_then(|e| e.draw.clone());
+    for (e, &kind) in s
+        .runs
+        .iter()
+        .zip(&kinds)
+        .filter(|(e, _)| e.draw == first_draw)
+    {
         let extrapolated: Vec<GroupMeans> = e
             .comparison
             .periods

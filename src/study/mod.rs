@@ -36,10 +36,11 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
         } => regimes::run(plan, runs, *tau_rev, *min_relative),
         StudyKind::Horizon {
             source,
+            draws,
             recorded_periods,
             seed,
             images,
-        } => horizon::run(plan, source, recorded_periods, *seed, images),
+        } => horizon::run(plan, source, draws, recorded_periods, *seed, images),
     }
 }
 

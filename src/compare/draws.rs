@@ -1,0 +1,546 @@
+//! The statistical bar: whether an extrapolation passes as one more DEM run, judged over
+//! several draws of one case instead of one recording.
+//!
+//! One recording's median ratio is a noisy figure: a genuine DEM run judged in the
+//! extrapolation's seat against the others is at most 1 in only about two windows of three.
+//! So the judgement that settles the question is pooled over draws (recordings of the same
+//! case with other seeds, or other recorded windows), each compared as `tdex compare` does:
+//! the extrapolation's mean median ratio over the draws beside a genuine DEM run's judged in
+//! the same seat, each with its standard error over the draws, and the share of compared
+//! `t_k` outside the DEM runs' range for both.
+
+use super::verdict::{kelvin, num};
+use super::{CompareError, Comparison, ContrastKind};
+use serde::Serialize;
+use tdex_format::RecordingInfo;
+
+/// Least draws a pooled verdict is given: with one, `tdex compare`'s own verdict is the
+/// judgement, and there is no standard error to weigh it by.
+pub const MIN_DRAWS: usize = 2;
+
+/// Least DEM runs (the reference and two twins) in every draw: a DEM run judged in the
+/// extrapolation's seat needs two others to measure its distance against.
+pub const MIN_DEM_RUNS: usize = 3;
+
+/// How many standard errors of the difference the extrapolation's mean median ratio may
+/// stand above the DEM runs' (about a 2.5 % one-sided chance of failing a method that is a
+/// DEM run in law).
+pub const STANDARD_ERRORS: f64 = 2.0;
+
+/// How much larger (as a share of the compared `t_k`, 10 percentage points) the
+/// extrapolation's share outside the DEM runs' range may be than the DEM runs' own.
+pub const OUTSIDE_SHARE_MARGIN: f64 = 0.10;
+
+/// Room for float noise when a group (bed) mean error is set against the DEM runs'
+/// spread, K: a conserved bed mean differs between runs only by rounding, and so does its
+/// error, which must then not fail on the last bits.
+const MEANS_TOLERANCE: f64 = 1e-9;
+
+/// Room for float noise when shares (whole counts of `t_k` over the compared ones) are set
+/// against their bar, so that a share exactly on the bar counts as on it.
+const SHARE_TOLERANCE: f64 = 1e-12;
+
+/// A mean over the draws and its standard error (the sample standard deviation over √n).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MeanSe {
+    pub mean: f64,
+    pub standard_error: f64,
+}
+
+impl MeanSe {
+    /// The mean of `values` and its standard error, `s / √n` with the sample standard
+    /// deviation `s` (divided by `n − 1`); `None` with fewer than two values, which have no
+    /// spread to measure.
+    pub fn of(values: &[f64]) -> Option<Self> {
+        let n = values.len();
+        if n < 2 {
+            return None;
+        }
+        let mean = values.iter().sum::<f64>() / n as f64;
+        let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+        Some(MeanSe {
+            mean,
+            standard_error: (variance / n as f64).sqrt(),
+        })
+    }
+}
+
+/// One draw's figures, from its comparison.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Draw {
+    pub recording: String,
+    pub extrapolation: String,
+    /// The extrapolation's median ratio to the DEM runs' spread over the compared `t_k`.
+    pub median_ratio: f64,
+    /// Its share of the compared `t_k` outside the DEM runs' range (0 to 1).
+    pub outside_share: f64,
+    /// The compared `t_k`.
+    pub compared: usize,
+    /// The DEM runs judged in the seat, each against the others: the mean of their
+    /// medians, and of their shares outside the others' range. One figure per draw, since
+    /// the runs of one draw share its reference and are not independent of each other.
+    pub dem_runs_median_ratio: f64,
+    pub dem_runs_outside_share: f64,
+    /// The largest error of the group means (the bed mean for a bed without groups) over
+    /// the compared `t_k`, and the largest difference between two DEM runs' means there, K.
+    pub means_error_max: f64,
+    pub means_spread_max: f64,
+    /// Whether the means are the hot and cold group means (else the bed mean).
+    #[serde(skip)]
+    pub groups: bool,
+}
+
+impl Draw {
+    /// The figures of comparison `c`, refused where they cannot be pooled: fewer than
+    /// [`MIN_DEM_RUNS`] DEM runs, or no median ratio for the extrapolation or the runs.
+    pub fn of(c: &Comparison) -> Result<Self, CompareError> {
+        if c.dem_runs < MIN_DEM_RUNS {
+            return Err(CompareError::DrawTooFewRuns {
+                recording: c.recording.clone(),
+                dem_runs: c.dem_runs,
+            });
+        }
+        let v = &c.verdict;
+        let not_judged = || CompareError::DrawNotJudged {
+            extrapolation: c.extrapolation.clone(),
+            recording: c.recording.clone(),
+            verdict: v.text.clone(),
+        };
+        let mean = |values: &[f64]| {
+            (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
+        };
+        Ok(Draw {
+            recording: c.recording.clone(),
+            extrapolation: c.extrapolation.clone(),
+            median_ratio: v.median_ratio.ok_or_else(not_judged)?,
+            outside_share: v.outside_share().ok_or_else(not_judged)?,
+            compared: v.compared.len(),
+            dem_runs_median_ratio: mean(&v.dem_runs_median_ratio).ok_or_else(not_judged)?,
+            dem_runs_outside_share: mean(&v.dem_runs_outside_share).ok_or_else(not_judged)?,
+            means_error_max: v.means_error_max.ok_or_else(not_judged)?,
+            means_spread_max: v.means_spread_max.ok_or_else(not_judged)?,
+            groups: c.contrast == ContrastKind::HotCold,
+        })
+    }
+
+    /// Whether the group (bed) means are within the DEM runs' spread at every compared
+    /// `t_k`: the largest error no larger than the largest difference between two runs.
+    pub fn means_within_spread(&self) -> bool {
+        self.means_error_max <= self.means_spread_max + MEANS_TOLERANCE
+    }
+}
+
+/// The pooled judgement over several draws of one case.
+#[derive(Debug, Clone, Serialize)]
+pub struct Draws {
+    pub draws: usize,
+    /// Whether the extrapolation passes as one more DEM run over the draws: all three of
+    /// `median_ratio_within`, `outside_share_within` and `means_within_spread`.
+    pub passes: bool,
+    /// The extrapolation's median ratio, and the DEM runs' judged in the seat, over the
+    /// draws.
+    pub median_ratio: MeanSe,
+    pub dem_runs_median_ratio: MeanSe,
+    /// The DEM runs' mean plus [`STANDARD_ERRORS`] standard errors of the difference
+    /// (`√(SE_x² + SE_dem²)`): the most the extrapolation's mean may be.
+    pub median_ratio_bar: f64,
+    pub median_ratio_within: bool,
+    /// The shares of compared `t_k` outside the DEM runs' range (0 to 1), the
+    /// extrapolation's and the DEM runs' in the seat, over the draws.
+    pub outside_share: MeanSe,
+    pub dem_runs_outside_share: MeanSe,
+    /// The DEM runs' mean share plus [`OUTSIDE_SHARE_MARGIN`].
+    pub outside_share_bar: f64,
+    pub outside_share_within: bool,
+    /// Whether every draw has its group (bed) means within the DEM runs' spread, how many
+    /// do not, and the largest error over the draws with that draw's spread beside it (K).
+    pub means_within_spread: bool,
+    pub means_outside_spread_draws: usize,
+    pub means_error_max: f64,
+    pub means_spread_beside: f64,
+    /// Each draw's figures, in the order given.
+    pub each: Vec<Draw>,
+    /// The judgement in words.
+    pub text: String,
+}
+
+impl Draws {
+    /// The pooled judgement over `each` draw; refused with fewer than [`MIN_DRAWS`].
+    ///
+    /// It passes when (a) the extrapolation's mean median ratio is at most the DEM runs'
+    /// mean in the seat plus two standard errors of the difference, (b) its mean share of
+    /// `t_k` outside the DEM runs' range is at most theirs plus 10 percentage points, and
+    /// (c) its group means (the bed mean for a bed without groups) are within the DEM runs'
+    /// spread at every compared `t_k` of every draw.
+    pub fn pool(each: Vec<Draw>) -> Result<Self, CompareError> {
+        if each.len() < MIN_DRAWS {
+            return Err(CompareError::TooFewDraws { draws: each.len() });
+        }
+        let over = |figure: fn(&Draw) -> f64| {
+            let values: Vec<f64> = each.iter().map(figure).collect();
+            MeanSe::of(&values).expect("two draws or more")
+        };
+        let median_ratio = over(|d| d.median_ratio);
+        let dem_runs_median_ratio = over(|d| d.dem_runs_median_ratio);
+        let outside_share = over(|d| d.outside_share);
+        let dem_runs_outside_share = over(|d| d.dem_runs_outside_share);
+        let difference_se = median_ratio
+            .standard_error
+            .hypot(dem_runs_median_ratio.standard_error);
+        let median_ratio_bar = dem_runs_median_ratio.mean + STANDARD_ERRORS * difference_se;
+        let median_ratio_within = median_ratio.mean <= median_ratio_bar;
+        let outside_share_bar = dem_runs_outside_share.mean + OUTSIDE_SHARE_MARGIN;
+        let outside_share_within = outside_share.mean <= outside_share_bar + SHARE_TOLERANCE;
+        let means_outside_spread_draws = each.iter().filter(|d| !d.means_within_spread()).count();
+        let worst = each
+            .iter()
+            .max_by(|a, b| a.means_error_max.total_cmp(&b.means_error_max))
+            .expect("two draws or more");
+        let (means_error_max, means_spread_beside) =
+            (worst.means_error_max, worst.means_spread_max);
+        let means_within_spread = means_outside_spread_draws == 0;
+        let passes = median_ratio_within && outside_share_within && means_within_spread;
+
+        let n = each.len();
+        let ratio_words = format!(
+            "mean median ratio {} against {} for a DEM run judged in the same seat, {} the bar \
+             of {} (theirs plus two standard errors of the difference)",
+            plus_minus(median_ratio),
+            plus_minus(dem_runs_median_ratio),
+            if median_ratio_within {
+                "within"
+            } else {
+                "above"
+            },
+            fixed(median_ratio_bar, decimals(difference_se, 2)),
+        );
+        let outside_words = format!(
+            "farther than the two farthest DEM runs at {} of the compared t_k against {} for a \
+             DEM run in the seat, {} the bar of {} % (theirs plus {} points)",
+            percent_plus_minus(outside_share),
+            percent_plus_minus(dem_runs_outside_share),
+            if outside_share_within {
+                "within"
+            } else {
+                "above"
+            },
+            fixed(
+                100.0 * outside_share_bar,
+                decimals(100.0 * dem_runs_outside_share.standard_error, 0)
+            ),
+            num(100.0 * OUTSIDE_SHARE_MARGIN),
+        );
+        let what = if worst.groups {
+            "group means"
+        } else {
+            "bed mean"
+        };
+        let where_ = if means_within_spread {
+            "within the DEM runs' spread at every compared t_k of every draw".to_string()
+        } else {
+            format!(
+                "beyond the DEM runs' spread at some compared t_k in \
+                 {means_outside_spread_draws} of the {n} draws"
+            )
+        };
+        let means_words = format!(
+            "{what} {where_} (the largest error {}, in a draw whose DEM runs differ by up to {})",
+            kelvin(means_error_max),
+            kelvin(means_spread_beside),
+        );
+        let text = format!(
+            "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
+             {means_words}",
+            if passes { "passes" } else { "does not pass" }
+        );
+        Ok(Draws {
+            draws: n,
+            passes,
+            median_ratio,
+            dem_runs_median_ratio,
+            median_ratio_bar,
+            median_ratio_within,
+            outside_share,
+            dem_runs_outside_share,
+            outside_share_bar,
+            outside_share_within,
+            means_within_spread,
+            means_outside_spread_draws,
+            means_error_max,
+            means_spread_beside,
+            each,
+            text,
+        })
+    }
+
+    /// The pooled figures as a small table: the extrapolation beside a DEM run in the seat.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "{:<34} {:>16} {:>20}\n",
+            "over the draws (mean ± SE)", "extrapolation", "DEM run in the seat"
+        );
+        s += &format!(
+            "{:<34} {:>16} {:>20}\n",
+            "median ratio",
+            plus_minus(self.median_ratio),
+            plus_minus(self.dem_runs_median_ratio)
+        );
+        s += &format!(
+            "{:<34} {:>16} {:>20}\n",
+            "beyond the DEM runs' range (% t_k)",
+            percent_plus_minus(self.outside_share),
+            percent_plus_minus(self.dem_runs_outside_share)
+        );
+        s
+    }
+}
+
+/// Whether `draw` (a recording, by its path) is of the same case as `first`: the same case
+/// name, particle count and period τ (the draws differ by their seed or their recorded
+/// window, and their ratios are measured over periods of one length).
+pub fn check_same_case(
+    (first, first_info): (&str, &RecordingInfo),
+    (draw, info): (&str, &RecordingInfo),
+) -> Result<(), CompareError> {
+    let name = |i: &RecordingInfo| {
+        i.case_resolved
+            .get("name")
+            .and_then(|v| v.as_str())
+            .unwrap_or("")
+            .to_string()
+    };
+    let differs = if name(info) != name(first_info) {
+        Some(format!(
+            "its case is named \"{}\" and the other's \"{}\"",
+            name(info),
+            name(first_info)
+        ))
+    } else if info.particles != first_info.particles {
+        Some(format!(
+            "it holds {} particles and the other {}",
+            info.particles, first_info.particles
+        ))
+    } else if (info.tau - first_info.tau).abs() > 0.5 * first_info.dt.min(info.dt) {
+        Some(format!(
+            "its period τ is {} s and the other's {} s",
+            crate::fmt::sig(info.tau, 6),
+            crate::fmt::sig(first_info.tau, 6)
+        ))
+    } else {
+        None
+    };
+    match differs {
+        Some(what) => Err(CompareError::OtherCase {
+            draw: draw.to_string(),
+            first: first.to_string(),
+            what,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The decimals (at least `least`, at most 6) that show the leading digit of a standard
+/// error `se` (`0.13`, `0.05`, `0.001`).
+fn decimals(se: f64, least: usize) -> usize {
+    if se > 0.0 && se.is_finite() {
+        (-se.log10().floor()).clamp(least as f64, 6.0) as usize
+    } else {
+        least
+    }
+}
+
+fn fixed(x: f64, decimals: usize) -> String {
+    format!("{x:.decimals$}")
+}
+
+/// `1.38 ± 0.05`: a mean with the decimals of its standard error.
+pub fn plus_minus(m: MeanSe) -> String {
+    let d = decimals(m.standard_error, 2);
+    format!("{} ± {}", fixed(m.mean, d), fixed(m.standard_error, d))
+}
+
+/// `33 ± 8 %`: a share (0 to 1) in percent, with the decimals of its standard error.
+pub fn percent_plus_minus(m: MeanSe) -> String {
+    let (mean, se) = (100.0 * m.mean, 100.0 * m.standard_error);
+    let d = decimals(se, 0);
+    format!("{} ± {} %", fixed(mean, d), fixed(se, d))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn draw(median: f64, outside: f64, dem_median: f64, dem_outside: f64) -> Draw {
+        Draw {
+            recording: "a.mcap".into(),
+            extrapolation: "a.extra.mcap".into(),
+            median_ratio: median,
+            outside_share: outside,
+            compared: 10,
+            dem_runs_median_ratio: dem_median,
+            dem_runs_outside_share: dem_outside,
+            means_error_max: 0.01,
+            means_spread_max: 0.02,
+            groups: true,
+        }
+    }
+
+    #[test]
+    fn the_standard_error_is_the_sample_deviation_over_the_root_of_the_count() {
+        assert_eq!(MeanSe::of(&[]), None);
+        assert_eq!(MeanSe::of(&[1.0]), None);
+        // 1, 2, 3: mean 2, sample variance 1, SE 1/√3
+        let m = MeanSe::of(&[1.0, 2.0, 3.0]).unwrap();
+        assert_eq!(m.mean, 2.0);
+        assert!((m.standard_error - 1.0 / 3f64.sqrt()).abs() < 1e-15);
+        // two values: SE = |a − b| / 2
+        let m = MeanSe::of(&[1.2, 1.6]).unwrap();
+        assert!((m.mean - 1.4).abs() < 1e-15);
+        assert!((m.standard_error - 0.2).abs() < 1e-15);
+        // no spread, no error
+        assert_eq!(MeanSe::of(&[0.5; 4]).unwrap().standard_error, 0.0);
+    }
+
+    /// (a): the mean median ratio against the DEM runs' mean plus two standard errors of
+    /// the difference.
+    #[test]
+    fn the_mean_median_ratio_may_exceed_the_dem_runs_by_two_standard_errors_of_the_difference() {
+        // extrapolation 1.0, 1.2 (mean 1.1, SE 0.1); DEM 0.9, 1.1 (mean 1, SE 0.1): the
+        // bar is 1 + 2 √0.02 ≈ 1.283
+        let pooled = Draws::pool(vec![draw(1.0, 0.3, 0.9, 0.3), draw(1.2, 0.3, 1.1, 0.3)]).unwrap();
+        assert!((pooled.median_ratio.mean - 1.1).abs() < 1e-12);
+        assert!((pooled.dem_runs_median_ratio.standard_error - 0.1).abs() < 1e-12);
+        assert!((pooled.median_ratio_bar - (1.0 + 2.0 * 0.02f64.sqrt())).abs() < 1e-12);
+        assert!(
+            pooled.median_ratio_within && pooled.passes,
+            "{}",
+            pooled.text
+        );
+        assert!(
+            pooled.text.starts_with(
+                "passes as one more DEM run over the 2 draws: mean median ratio 1.10 ± 0.10 \
+                 against 1.00 ± 0.10 for a DEM run judged in the same seat, within the bar of \
+                 1.28"
+            ),
+            "{}",
+            pooled.text
+        );
+        // the same spread, a mean 0.3 higher: above the bar
+        let pooled = Draws::pool(vec![draw(1.3, 0.3, 0.9, 0.3), draw(1.5, 0.3, 1.1, 0.3)]).unwrap();
+        assert!(!pooled.median_ratio_within && !pooled.passes);
+        assert!(
+            pooled.text.starts_with("does not pass")
+                && pooled.text.contains("above the bar of 1.28"),
+            "{}",
+            pooled.text
+        );
+        // tight draws: a small excess is already a failure
+        let pooled = Draws::pool(vec![
+            draw(1.05, 0.3, 1.0, 0.3),
+            draw(1.05, 0.3, 1.0, 0.3),
+            draw(1.05, 0.3, 1.0, 0.3),
+        ])
+        .unwrap();
+        assert_eq!(pooled.median_ratio_bar, 1.0);
+        assert!(!pooled.passes);
+    }
+
+    /// (b): the outside share may exceed the DEM runs' by 10 points, not more.
+    #[test]
+    fn the_outside_share_may_exceed_the_dem_runs_by_ten_points() {
+        let on_the_bar =
+            Draws::pool(vec![draw(1.0, 0.4, 1.0, 0.3), draw(1.0, 0.4, 1.0, 0.3)]).unwrap();
+        assert!(on_the_bar.outside_share_within, "{}", on_the_bar.text);
+        assert!(on_the_bar.passes);
+        assert!(
+            on_the_bar.text.contains(
+                "farther than the two farthest DEM runs at 40 ± 0 % of the compared t_k \
+                 against 30 ± 0 % for a DEM run in the seat, within the bar of 40 % (theirs \
+                 plus 10 points)"
+            ),
+            "{}",
+            on_the_bar.text
+        );
+        let beyond = Draws::pool(vec![draw(1.0, 0.5, 1.0, 0.3), draw(1.0, 0.4, 1.0, 0.3)]).unwrap();
+        assert!((beyond.outside_share.mean - 0.45).abs() < 1e-12);
+        assert!(!beyond.outside_share_within && !beyond.passes);
+        assert!(
+            beyond.text.contains("above the bar of 40 %"),
+            "{}",
+            beyond.text
+        );
+    }
+
+    /// (c): the group means within the DEM runs' spread in every draw; the failing draws
+    /// are counted and the worst error given beside its draw's spread.
+    #[test]
+    fn the_means_must_be_within_the_spread_in_every_draw() {
+        let mut draws = vec![
+            draw(1.0, 0.3, 1.0, 0.3),
+            draw(1.0, 0.3, 1.0, 0.3),
+            draw(1.0, 0.3, 1.0, 0.3),
+        ];
+        let within = Draws::pool(draws.clone()).unwrap();
+        assert!(within.means_within_spread && within.passes);
+        assert!(
+            within.text.ends_with(
+                "group means within the DEM runs' spread at every compared t_k of every draw \
+                 (the largest error 0.0100 K, in a draw whose DEM runs differ by up to 0.0200 K)"
+            ),
+            "{}",
+            within.text
+        );
+        draws[1].means_error_max = 0.15;
+        draws[1].means_spread_max = 0.03;
+        let outside = Draws::pool(draws.clone()).unwrap();
+        assert!(!outside.means_within_spread && !outside.passes);
+        assert_eq!(outside.means_outside_spread_draws, 1);
+        assert_eq!(
+            (outside.means_error_max, outside.means_spread_beside),
+            (0.15, 0.03)
+        );
+        assert!(
+            outside.text.contains(
+                "group means beyond the DEM runs' spread at some compared t_k in 1 of the 3 \
+                 draws (the largest error 0.150 K, in a draw whose DEM runs differ by up to \
+                 0.0300 K)"
+            ),
+            "{}",
+            outside.text
+        );
+        // a conserved bed mean: error and spread both rounding, which does not fail
+        for d in &mut draws {
+            d.groups = false;
+            d.means_error_max = 3e-14;
+            d.means_spread_max = 1e-14;
+        }
+        let conserved = Draws::pool(draws).unwrap();
+        assert!(conserved.means_within_spread, "{}", conserved.text);
+        assert!(
+            conserved.text.contains("bed mean within"),
+            "{}",
+            conserved.text
+        );
+    }
+
+    #[test]
+    fn one_draw_is_refused() {
+        let err = Draws::pool(vec![draw(1.0, 0.3, 1.0, 0.3)]).unwrap_err();
+        assert!(matches!(err, CompareError::TooFewDraws { draws: 1 }));
+        assert!(err.to_string().contains("at least 2 draws"), "{err}");
+    }
+
+    #[test]
+    fn means_are_written_with_the_decimals_of_their_standard_error() {
+        let m = |mean, standard_error| MeanSe {
+            mean,
+            standard_error,
+        };
+        assert_eq!(plus_minus(m(1.4112, 0.1304)), "1.41 ± 0.13");
+        assert_eq!(plus_minus(m(0.99812, 0.0012)), "0.998 ± 0.001");
+        assert_eq!(plus_minus(m(1.0, 0.0)), "1.00 ± 0.00");
+        assert_eq!(percent_plus_minus(m(0.952, 0.048)), "95 ± 5 %");
+        assert_eq!(percent_plus_minus(m(0.3333, 0.0)), "33 ± 0 %");
+        assert_eq!(percent_plus_minus(m(0.125, 0.004)), "12.5 ± 0.4 %");
+    }
+}
