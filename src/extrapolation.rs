@@ -10,7 +10,7 @@ use extrapolate::{
     ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest, MemoryLimit, Notice, TableChoice,
 };
 use serde::Serialize;
-use tdex_format::extrapolation::{RecurrencePath, Roles, Symmetry};
+use tdex_format::extrapolation::{Boundary, FreshPool, RecurrencePath, Roles, Symmetry};
 use tdex_format::ExtrapolationCosts;
 
 /// `tdex extrapolate --json` (keys in docs/user-guide.md).
@@ -32,6 +32,12 @@ struct ExtrapolationReport {
     /// With `--mirror`: each start's mirrored and plain pairings' mean distances.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     mirror_check: Vec<extrapolate::MirrorCheck>,
+    /// With `--boundary fresh`: the boundary (pool, cell, seed) and each start's pool;
+    /// absent for the exact pairing.
+    #[serde(skip_serializing_if = "Boundary::is_exact")]
+    boundary: Boundary,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    fresh_pools: Vec<FreshPool>,
     costs: ExtrapolationCosts,
     total_heat_t1: f64,
     total_heat_end: f64,
@@ -58,6 +64,8 @@ impl ExtrapolationReport {
             },
             symmetry: outcome.symmetry,
             mirror_check: outcome.mirror_check,
+            boundary: outcome.boundary,
+            fresh_pools: outcome.fresh_pools,
             costs: outcome.costs,
             total_heat_t1: outcome.total_heat_t1,
             total_heat_end: outcome.total_heat_end,
@@ -178,6 +186,50 @@ pub fn mirror_check_lines(checks: &[extrapolate::MirrorCheck]) -> Vec<String> {
     lines
 }
 
+/// The fresh boundary maps in plain words: what each jump draws, then each start's pool
+/// (nothing for the exact pairing, which the pairing line already tells).
+pub fn boundary_lines(boundary: Boundary, pools: &[FreshPool]) -> Vec<String> {
+    let sig = |x: f64| crate::fmt::sig(x, 3);
+    let what = match boundary {
+        Boundary::Exact => return Vec::new(),
+        Boundary::FreshSteps {
+            pool,
+            cell_diameters,
+            seed,
+        } => format!(
+            "fresh steps: each jump draws one of {pool} pairings in which every particle's \
+             step along the axis is redrawn within {}-diameter cells of the cross-section \
+             (seed {seed})",
+            sig(cell_diameters)
+        ),
+        Boundary::FreshDrift {
+            pool,
+            bin_diameters,
+            cell_diameters,
+            seed,
+        } => format!(
+            "fresh drift: each jump draws one of {pool} pairings in which the period's axial \
+             drift ({}-diameter bins, {}-diameter cells of the cross-section) is moved along \
+             the axis (seed {seed})",
+            sig(bin_diameters),
+            sig(cell_diameters)
+        ),
+    };
+    let mut lines = vec![what];
+    lines.extend(pools.iter().map(|p| {
+        format!(
+            "t{} to t{}: {} pairings, mean distance {} diameters ({} to {})",
+            p.end,
+            p.start,
+            p.pairings,
+            crate::fmt::sig(p.mean_distance_diameters, 4),
+            crate::fmt::sig(p.min_mean_distance_diameters, 4),
+            crate::fmt::sig(p.max_mean_distance_diameters, 4)
+        )
+    }));
+    lines
+}
+
 /// The start a pairing joins the end to: `t<start>`, or its mirror image.
 pub fn start_words(start: u32, symmetry: Symmetry) -> String {
     match symmetry {
@@ -230,6 +282,7 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         path_seed: plan.seed,
         jump_targets: plan.jump_to.clone(),
         symmetry: plan.symmetry,
+        boundary: plan.boundary,
     };
     let outcome = crate::with_workers(plan.threads, || {
         extrapolate::extrapolate_recording(&request, tell).map_err(advice)
@@ -442,6 +495,9 @@ pub fn print(
         }
         for line in mirror_check_lines(&report.mirror_check) {
             println!("mirror check  {line}");
+        }
+        for line in boundary_lines(report.boundary, &report.fresh_pools) {
+            println!("boundary      {line}");
         }
         println!(
             "replay        {:.3} s per period, {:.3e} rows/s (table read {:.2} s, {})",

@@ -238,6 +238,12 @@ struct ExtrapolationInspection {
     /// With the mirror: each start's mirrored pairing beside its plain one, as stored.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     mirror_check: Vec<tdex_format::extrapolation::MirrorCheck>,
+    /// With fresh boundary maps: the boundary (pool, cell, seed) and each start's pool, as
+    /// stored; absent for the exact pairing.
+    #[serde(skip_serializing_if = "tdex_format::extrapolation::Boundary::is_exact")]
+    boundary: tdex_format::extrapolation::Boundary,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    fresh_pools: Vec<tdex_format::extrapolation::FreshPool>,
     /// Σ m c T (J) over the particles at the first snapshot (`t1`) and at the last, with
     /// `m c = density · heat_capacity · (4/3)π r³` of the recording's material.
     total_heat_start: f64,
@@ -825,6 +831,8 @@ fn inspect_extrapolation(plan: &InspectPlan, reader: &ExtrapolationReader) -> Re
         roles: info.roles.clone(),
         symmetry: info.symmetry,
         mirror_check: info.mirror_check.clone(),
+        boundary: info.boundary,
+        fresh_pools: info.fresh_pools.clone(),
         total_heat_start: start,
         total_heat_end: end,
         heat_relative_change: (end - start) / start,
@@ -894,6 +902,9 @@ fn print_extrapolation(s: &ExtrapolationInspection) {
     }
     for line in crate::extrapolation::mirror_check_lines(&s.mirror_check) {
         println!("mirror check  {line}");
+    }
+    for line in crate::extrapolation::boundary_lines(s.boundary, &s.fresh_pools) {
+        println!("boundary      {line}");
     }
     println!(
         "heat          Σ m c T {:.6e} J at the start, {:.6e} J at the end (relative change {:.2e})",

@@ -441,6 +441,69 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     let md = std::fs::read_to_string(mirrored.join("study.md")).unwrap();
     assert!(md.contains("P = 2, mirror: mirror check t"), "{md}");
 
+    // with --boundary every P runs with each boundary, the exact one as without the flag,
+    // each fresh one with its own file, the same as `tdex extrapolate --boundary` makes
+    let fresh = dir.path().join("fresh");
+    let study4 = horizon_from_recording(
+        &rec,
+        &["--boundary", "exact,fresh-steps,fresh-drift"],
+        &fresh,
+    );
+    let runs4 = study4["runs"].as_array().unwrap();
+    let shape: Vec<(u64, Option<&str>)> = runs4
+        .iter()
+        .map(|r| {
+            (
+                r["recorded_periods"].as_u64().unwrap(),
+                r.get("boundary").map(|b| b.as_str().unwrap()),
+            )
+        })
+        .collect();
+    assert_eq!(
+        shape,
+        [
+            (1, None),
+            (1, Some("fresh_steps")),
+            (1, Some("fresh_drift")),
+            (2, None),
+            (2, Some("fresh_steps")),
+            (2, Some("fresh_drift"))
+        ]
+    );
+    for (plain, again) in runs.iter().zip([&runs4[0], &runs4[3]]) {
+        assert_eq!(plain["median_ratio"], again["median_ratio"]);
+    }
+    let steps = fresh.join("by_hand.mcap");
+    ok(&[
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "2",
+        "--periods",
+        &study4["reference_periods"].to_string(),
+        "--boundary",
+        "fresh-steps",
+        "-o",
+        steps.to_str().unwrap(),
+    ]);
+    let studied = runs4[4]["extrapolation"].as_str().unwrap();
+    assert!(
+        studied.ends_with("horizon_p2_fresh-steps.extra.mcap"),
+        "{studied}"
+    );
+    let snapshots = |path: &Path| {
+        tdex_format::ExtrapolationReader::open(path)
+            .unwrap()
+            .snapshots()
+            .unwrap()
+            .into_iter()
+            .map(|s| s.temp)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(snapshots(&steps), snapshots(Path::new(studied)));
+    let md = std::fs::read_to_string(fresh.join("study.md")).unwrap();
+    assert!(md.contains("P = 2, fresh steps"), "{md}");
+
     // a recording has its own reference periods; it cannot replay more periods than it holds
     for (flags, expect) in [
         (vec!["--reference", "5"], "--reference: "),

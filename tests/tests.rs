@@ -4,6 +4,7 @@
 mod util;
 
 mod cli_bench;
+mod cli_boundary;
 mod cli_case_errors;
 mod cli_checkpoint;
 mod cli_compare;

@@ -52,6 +52,13 @@ pub enum ExtrapolateError {
         recording.display()
     )]
     NoMirrorImage { recording: PathBuf },
+    /// Fresh boundary maps asked of a recording whose drum axis is not known.
+    #[error(
+        "{}: its case has no [drum], so the drum's axis is not known (fresh boundary maps \
+         redraw the particles' steps along a tdex drum's axis y; use --boundary exact)",
+        recording.display()
+    )]
+    NoDrumAxis { recording: PathBuf },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -70,7 +77,8 @@ impl Classify for ExtrapolateError {
             | ExtrapolateError::Refused { .. }
             | ExtrapolateError::RecordedPeriods { .. }
             | ExtrapolateError::JumpTarget { .. }
-            | ExtrapolateError::NoMirrorImage { .. } => Fault::Input,
+            | ExtrapolateError::NoMirrorImage { .. }
+            | ExtrapolateError::NoDrumAxis { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)

@@ -4,6 +4,7 @@
 //! [`sidecar`] stores the pairing beside the recording and [`cache`] reuses it;
 //! [`extrapolate_recording`] extrapolates a recording with them.
 
+pub mod boundary;
 pub mod cache;
 mod driver;
 mod error;

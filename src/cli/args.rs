@@ -228,9 +228,49 @@ pub struct ExtrapolateArgs {
     /// tdex drum.
     #[arg(long)]
     pub mirror: bool,
+    /// How the roles are handed over at each jump: `exact` is the one optimal pairing of the
+    /// paper's method; `fresh-steps` and `fresh-drift` draw one of a pool of pairings in which
+    /// the recorded period's displacement along the drum's axis is drawn again, so that it is
+    /// fresh every period instead of repeated (docs/method.md §6): `fresh-steps` redraws each
+    /// particle's axial step (for a bed heated through its mantle), `fresh-drift` moves the
+    /// period's coarse axial drift along the axis (for heat that varies along the axis).
+    #[arg(long, value_enum, default_value_t = BoundaryKind::Exact)]
+    pub boundary: BoundaryKind,
+    /// With a fresh boundary: pairings in each start's pool [default: 32].
+    #[arg(long = "boundary-pool", value_name = "N", value_parser = pool())]
+    pub boundary_pool: Option<u32>,
+    /// With a fresh boundary: width of the cells of the cross-section whose particles' axial
+    /// steps (`fresh-steps`) or drift (`fresh-drift`) are taken together, in particle
+    /// diameters [default: 3].
+    #[arg(
+        long = "boundary-cell",
+        value_name = "DIAMETERS",
+        value_parser = positive("give a width in particle diameters > 0")
+    )]
+    pub boundary_cell: Option<f64>,
+    /// With `--boundary fresh-drift`: length of the axial bins of the drift, in particle
+    /// diameters [default: 2].
+    #[arg(
+        long = "boundary-bin",
+        value_name = "DIAMETERS",
+        value_parser = positive("give a length in particle diameters > 0")
+    )]
+    pub boundary_bin: Option<f64>,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `tdex extrapolate --boundary`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum BoundaryKind {
+    /// One optimal pairing per start, the same at every jump (the paper's method).
+    Exact,
+    /// A pool of pairings with each particle's axial step redrawn, one drawn at each jump.
+    FreshSteps,
+    /// A pool of pairings with the coarse axial drift moved along the axis, one drawn at
+    /// each jump.
+    FreshDrift,
 }
 
 /// `tdex compare`.
@@ -623,6 +663,11 @@ pub struct HorizonStudyArgs {
     /// which of the two passes as one more DEM run on this case.
     #[arg(long)]
     pub mirror: bool,
+    /// The boundary maps every P runs with, comma-separated (`tdex extrapolate --boundary`,
+    /// with its default pool, cells and bins): e.g. `exact,fresh-steps,fresh-drift` puts
+    /// the three side by side on this case.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "exact")]
+    pub boundary: Vec<BoundaryKind>,
 }
 
 /// `tdex study regimes`.
@@ -682,6 +727,11 @@ fn periods() -> super::values::Count<u32> {
 /// `tdex extrapolate --recorded-periods`: at least one.
 fn periods_used() -> super::values::Count<u32> {
     count(1, "a whole number", "use at least 1 recorded period")
+}
+
+/// `tdex extrapolate --boundary-pool`: at least one pairing.
+fn pool() -> super::values::Count<u32> {
+    count(1, "a whole number", "give at least 1 pairing")
 }
 
 /// `--cells`: at least one Voronoi cell.

@@ -2,12 +2,13 @@
 //! each other, the files to read and write — is checked here, before any simulation starts.
 
 use super::args::{
-    BenchArgs, BenchCommand, BenchRecordArgs, Cli, Command, CompareArgs, DemoArgs, ExportCommand,
-    ExtrapolateArgs, HorizonStudyArgs, ImportCommand, InspectArgs, LiggghtsArgs, PairArgs,
-    PeriodStudyArgs, RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs,
+    BenchArgs, BenchCommand, BenchRecordArgs, BoundaryKind, Cli, Command, CompareArgs, DemoArgs,
+    ExportCommand, ExtrapolateArgs, HorizonStudyArgs, ImportCommand, InspectArgs, LiggghtsArgs,
+    PairArgs, PeriodStudyArgs, RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs,
     SamplingFlags, SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
 };
 use anyhow::Result;
+use extrapolate::boundary::BoundaryMaps;
 use extrapolate::replay::Scheme;
 use recorder::record::RecordOptions;
 use recorder::Case;
@@ -123,6 +124,8 @@ pub enum StudyKind {
         seed: Option<u64>,
         /// The images every P is run with: the paper's method, and the mirror if asked.
         images: Vec<Symmetry>,
+        /// The boundary maps every P and image is run with, distinct, in the order given.
+        boundaries: Vec<BoundaryMaps>,
     },
     /// One recording per drum speed (the case with its rotation period replaced).
     Regimes {
@@ -196,6 +199,8 @@ pub struct ExtrapolatePlan {
     pub jump_to: Option<Vec<u32>>,
     /// `--mirror`: the drum's mirror symmetry used at the jumps.
     pub symmetry: Symmetry,
+    /// `--boundary` with its pool and cell width.
+    pub boundary: BoundaryMaps,
     pub json: bool,
 }
 
@@ -426,6 +431,7 @@ impl PairPlan {
 impl ExtrapolatePlan {
     fn from_args(args: ExtrapolateArgs) -> Result<Self> {
         check_output(&args.output)?;
+        let boundary = boundary_maps(&args)?;
         Ok(ExtrapolatePlan {
             file: args.file,
             periods: args.periods,
@@ -443,9 +449,69 @@ impl ExtrapolatePlan {
             } else {
                 Symmetry::None
             },
+            boundary,
             json: args.json,
         })
     }
+}
+
+/// The boundary maps of `kind` with their default pool, cells and bins.
+fn default_maps(kind: BoundaryKind) -> BoundaryMaps {
+    use extrapolate::boundary::{DEFAULT_BIN_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL};
+    match kind {
+        BoundaryKind::Exact => BoundaryMaps::Exact,
+        BoundaryKind::FreshSteps => BoundaryMaps::FreshSteps {
+            pool: DEFAULT_POOL,
+            cell_diameters: DEFAULT_CELL_DIAMETERS,
+        },
+        BoundaryKind::FreshDrift => BoundaryMaps::FreshDrift {
+            pool: DEFAULT_POOL,
+            bin_diameters: DEFAULT_BIN_DIAMETERS,
+            cell_diameters: DEFAULT_CELL_DIAMETERS,
+        },
+    }
+}
+
+/// `--boundary` with `--boundary-pool`, `--boundary-cell` and `--boundary-bin`, which only
+/// the fresh maps take (and the bin only the drift).
+fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
+    use extrapolate::boundary::{DEFAULT_BIN_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL};
+    let pool = args.boundary_pool.unwrap_or(DEFAULT_POOL);
+    let cell_diameters = args.boundary_cell.unwrap_or(DEFAULT_CELL_DIAMETERS);
+    Ok(match args.boundary {
+        BoundaryKind::Exact => {
+            if args.boundary_pool.is_some()
+                || args.boundary_cell.is_some()
+                || args.boundary_bin.is_some()
+            {
+                return Err(usage(
+                    "--boundary-pool, --boundary-cell and --boundary-bin set the fresh \
+                     boundary maps; with --boundary exact there is one pairing per start (add \
+                     --boundary fresh-steps or fresh-drift)"
+                        .into(),
+                ));
+            }
+            BoundaryMaps::Exact
+        }
+        BoundaryKind::FreshSteps => {
+            if args.boundary_bin.is_some() {
+                return Err(usage(
+                    "--boundary-bin sets the bins of --boundary fresh-drift; fresh-steps \
+                     redraws each particle's step and has no bins"
+                        .into(),
+                ));
+            }
+            BoundaryMaps::FreshSteps {
+                pool,
+                cell_diameters,
+            }
+        }
+        BoundaryKind::FreshDrift => BoundaryMaps::FreshDrift {
+            pool,
+            bin_diameters: args.boundary_bin.unwrap_or(DEFAULT_BIN_DIAMETERS),
+            cell_diameters,
+        },
+    })
 }
 
 impl ComparePlan {
@@ -921,6 +987,7 @@ impl StudyKind {
             tau_rev,
             seed,
             mirror,
+            boundary,
         } = args;
         let mut recorded_periods = distinct(recorded_periods);
         recorded_periods.sort_unstable();
@@ -981,12 +1048,20 @@ impl StudyKind {
         } else {
             vec![Symmetry::None]
         };
+        let mut boundaries: Vec<BoundaryMaps> = Vec::new();
+        for &kind in &boundary {
+            let maps = default_maps(kind);
+            if !boundaries.contains(&maps) {
+                boundaries.push(maps);
+            }
+        }
         Ok(StudyKind::Horizon {
             source,
             draws,
             recorded_periods,
             seed,
             images,
+            boundaries,
         })
     }
 

@@ -19,6 +19,7 @@ use crate::compare::draws::{self, Draw, Draws};
 use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
+use extrapolate::boundary::BoundaryMaps;
 use extrapolate::{ExtrapolationRequest, MirrorCheck};
 use recorder::record;
 use serde::Serialize;
@@ -33,6 +34,10 @@ struct Entry {
     recorded_periods: u32,
     /// `none` (the paper's method) or `axial_mirror`.
     symmetry: Symmetry,
+    /// The boundary maps at the jumps, `fresh_steps` or `fresh_drift` (left out for the
+    /// exact pairing, the paper's method).
+    #[serde(skip_serializing_if = "is_exact")]
+    boundary: &'static str,
     /// The recording of this draw, with several (left out with one, whose recording is the
     /// study's).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -92,22 +97,42 @@ struct HorizonStudy {
 struct PooledRun {
     recorded_periods: u32,
     symmetry: Symmetry,
+    #[serde(skip_serializing_if = "is_exact")]
+    boundary: &'static str,
     #[serde(flatten)]
     draws: Draws,
 }
 
 impl PooledRun {
     fn label(&self) -> String {
-        label(self.recorded_periods, self.symmetry)
+        label(self.recorded_periods, self.symmetry, self.boundary)
     }
 }
 
-/// `P = 2`, or `P = 2, mirror`: a configuration's name in the table and the plots.
-fn label(p: u32, symmetry: Symmetry) -> String {
-    match symmetry {
-        Symmetry::None => format!("P = {p}"),
-        Symmetry::AxialMirror => format!("P = {p}, mirror"),
+/// `P = 2`, `P = 2, mirror` or `P = 2, fresh steps`: a configuration's name in the table and
+/// the plots.
+fn label(p: u32, symmetry: Symmetry, boundary: &str) -> String {
+    let mut label = format!("P = {p}");
+    if symmetry == Symmetry::AxialMirror {
+        label += ", mirror";
     }
+    if boundary != "exact" {
+        label += &format!(", {}", boundary.replace('_', " "));
+    }
+    label
+}
+
+/// The name of boundary maps in the study's outputs.
+fn boundary_name(maps: BoundaryMaps) -> &'static str {
+    match maps {
+        BoundaryMaps::Exact => "exact",
+        BoundaryMaps::FreshSteps { .. } => "fresh_steps",
+        BoundaryMaps::FreshDrift { .. } => "fresh_drift",
+    }
+}
+
+fn is_exact(name: &&'static str) -> bool {
+    *name == "exact"
 }
 
 /// Each recording's name as a draw (its file stem), made distinct by its place where two
@@ -140,6 +165,7 @@ pub fn run(
     recorded_periods: &[u32],
     seed: Option<u64>,
     images: &[Symmetry],
+    boundaries: &[BoundaryMaps],
 ) -> Result<()> {
     let dir = &plan.output;
     let recording = match source {
@@ -174,9 +200,13 @@ pub fn run(
         .collect();
     let several = recordings.len() > 1;
     let names = draw_names(&recordings);
-    let configurations: Vec<(u32, Symmetry)> = recorded_periods
+    let configurations: Vec<(u32, Symmetry, BoundaryMaps)> = recorded_periods
         .iter()
-        .flat_map(|&p| images.iter().map(move |&s| (p, s)))
+        .flat_map(|&p| {
+            images
+                .iter()
+                .flat_map(move |&s| boundaries.iter().map(move |&b| (p, s, b)))
+        })
         .collect();
     // per draw, every configuration in order
     let mut by_draw: Vec<Vec<Entry>> = Vec::with_capacity(recordings.len());
@@ -195,8 +225,8 @@ pub fn run(
         // ends them
         let draw = several.then_some(name.as_str());
         let mut entries = Vec::with_capacity(configurations.len());
-        for &(p, symmetry) in &configurations {
-            entries.push(run_one(plan, &rec, path, draw, p, symmetry, seed)?);
+        for &(p, symmetry, maps) in &configurations {
+            entries.push(run_one(plan, &rec, path, draw, (p, symmetry, maps), seed)?);
         }
         info.get_or_insert_with(|| rec.info().clone());
         by_draw.push(entries);
@@ -207,7 +237,7 @@ pub fn run(
         by_draw.into_iter().map(Vec::into_iter).collect();
     let mut runs = Vec::new();
     let mut pooled = Vec::new();
-    for &(p, symmetry) in &configurations {
+    for &(p, symmetry, maps) in &configurations {
         let entries: Vec<Entry> = by_draw
             .iter_mut()
             .map(|d| d.next().expect("one entry per configuration"))
@@ -220,6 +250,7 @@ pub fn run(
             pooled.push(PooledRun {
                 recorded_periods: p,
                 symmetry,
+                boundary: boundary_name(maps),
                 draws: Draws::pool(each)?,
             });
         }
@@ -253,30 +284,35 @@ pub fn run(
     )
 }
 
-/// Extrapolates the first `p` recorded periods of `rec` (at `path`) with `symmetry` at the
-/// jumps over its reference periods and compares it with the DEM runs; `draw` names the
-/// recording in the file name and the outputs when there are several.
+/// Extrapolates the first `p` recorded periods of `rec` (at `path`) with `symmetry` and the
+/// boundary `maps` at the jumps over its reference periods and compares it with the DEM
+/// runs; `draw` names the recording in the file name and the outputs when there are several.
 fn run_one(
     plan: &StudyPlan,
     rec: &RecordingReader,
     path: &Path,
     draw: Option<&str>,
-    p: u32,
-    symmetry: Symmetry,
+    (p, symmetry, maps): (u32, Symmetry, BoundaryMaps),
     seed: Option<u64>,
 ) -> Result<Entry> {
     let image = match symmetry {
         Symmetry::None => "",
         Symmetry::AxialMirror => "_mirror",
     };
+    let boundary = match maps {
+        BoundaryMaps::Exact => "",
+        BoundaryMaps::FreshSteps { .. } => "_fresh-steps",
+        BoundaryMaps::FreshDrift { .. } => "_fresh-drift",
+    };
     let suffix = draw.map_or(String::new(), |d| format!("_{d}"));
     let extra = plan
         .output
-        .join(format!("horizon_p{p}{image}{suffix}.extra.mcap"));
+        .join(format!("horizon_p{p}{image}{boundary}{suffix}.extra.mcap"));
     let request = ExtrapolationRequest {
         recorded_periods: Some(p),
         path_seed: seed,
         symmetry,
+        boundary: maps,
         ..ExtrapolationRequest::new(
             path.to_path_buf(),
             rec.info().reference_periods,
@@ -297,8 +333,7 @@ fn run_one(
     let ext = ExtrapolationReader::open(&extra)?;
     let comparison = compare::compare(rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
     let mut entry = Entry::new(
-        p,
-        symmetry,
+        (p, symmetry, boundary_name(maps)),
         outcome.mirror_check,
         &extra,
         rec.costs(),
@@ -330,7 +365,7 @@ impl Entry {
     /// `P = 2`, or `P = 2, mirror`, and the draw's name with several (`P = 2 (seed6)`): the
     /// run's name in the table and the plots.
     fn label(&self) -> String {
-        let label = label(self.recorded_periods, self.symmetry);
+        let label = label(self.recorded_periods, self.symmetry, self.boundary);
         match &self.draw {
             Some(d) => format!("{label} ({d})"),
             None => label,
@@ -338,8 +373,7 @@ impl Entry {
     }
 
     fn new(
-        p: u32,
-        symmetry: Symmetry,
+        (p, symmetry, boundary): (u32, Symmetry, &'static str),
         mirror_check: Vec<MirrorCheck>,
         extra: &Path,
         costs: Option<&RecordingCosts>,
@@ -350,6 +384,7 @@ impl Entry {
         Entry {
             recorded_periods: p,
             symmetry,
+            boundary,
             recording: None,
             draw: None,
             mirror_check,
@@ -447,8 +482,16 @@ fn pooled_table(s: &HorizonStudy) -> String {
          of compared t_k farther from the DEM runs than the two farthest of them):\n",
         s.draws.len()
     );
+    // as wide as `P = 2, mirror`, wider for the boundaries' names
+    let w = s
+        .pooled
+        .iter()
+        .map(|r| r.label().chars().count())
+        .max()
+        .unwrap_or(0)
+        .max(13);
     t += &format!(
-        "{:<13} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
+        "{:<w$} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
         "run",
         "median ratio",
         "beyond range",
@@ -459,7 +502,7 @@ fn pooled_table(s: &HorizonStudy) -> String {
     for r in &s.pooled {
         let d = &r.draws;
         t += &format!(
-            "{:<13} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
+            "{:<w$} {:>14} {:>16} {:>22} {:>24} {:>7}\n",
             r.label(),
             draws::plus_minus(d.median_ratio),
             draws::percent_plus_minus(d.outside_share),
@@ -534,17 +577,18 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
     )
 }
 
-/// Each run's line: one colour per P (in the order the runs come), the mirror's line
-/// dashed in its P's colour.
+/// Each run's line: one colour per P and boundary (in the order the runs come), the
+/// mirror's line dashed in its colour.
 fn line_kinds(runs: &[Entry]) -> Vec<LineKind> {
     let mut colour = 0;
-    let mut last_p = None;
+    let mut last = None;
     runs.iter()
         .map(|e| {
-            if last_p.is_some_and(|p| p != e.recorded_periods) {
+            let this = (e.recorded_periods, e.boundary);
+            if last.is_some_and(|l| l != this) {
                 colour += 1;
             }
-            last_p = Some(e.recorded_periods);
+            last = Some(this);
             match e.symmetry {
                 Symmetry::None => LineKind::Extrapolation(colour),
                 Symmetry::AxialMirror => LineKind::MirroredExtrapolation(colour),

@@ -40,7 +40,16 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
             recorded_periods,
             seed,
             images,
-        } => horizon::run(plan, source, draws, recorded_periods, *seed, images),
+            boundaries,
+        } => horizon::run(
+            plan,
+            source,
+            draws,
+            recorded_periods,
+            *seed,
+            images,
+            boundaries,
+        ),
     }
 }
 

@@ -10,11 +10,12 @@ mod run;
 
 pub use memory_limit::MemoryLimit;
 
+use crate::boundary::BoundaryMaps;
 use crate::replay::{MemoryPlan, Scheme};
 use crate::ExtrapolateError;
 use run::Extrapolation;
 use std::path::PathBuf;
-use tdex_format::extrapolation::{Roles, Symmetry};
+use tdex_format::extrapolation::{Boundary, FreshPool, Roles, Symmetry};
 use tdex_format::{ExtrapolationCosts, RecordingInfo};
 
 /// What to extrapolate, how far, and into which file.
@@ -45,6 +46,9 @@ pub struct ExtrapolationRequest {
     /// The drum's symmetry the jumps use: [`Symmetry::AxialMirror`] enters the mirror image
     /// of each start, alternating the recording and its image at every jump.
     pub symmetry: Symmetry,
+    /// How the roles are handed over at each jump: one exact pairing per start (the
+    /// paper's method) or a pool of fresh ones, drawn from the path's seed.
+    pub boundary: BoundaryMaps,
 }
 
 impl ExtrapolationRequest {
@@ -69,6 +73,7 @@ impl ExtrapolationRequest {
             path_seed: None,
             jump_targets: None,
             symmetry: Symmetry::None,
+            boundary: BoundaryMaps::Exact,
         }
     }
 }
@@ -111,6 +116,9 @@ pub struct ExtrapolationOutcome {
     pub symmetry: Symmetry,
     /// With the axial mirror: each start's mirrored pairing beside its plain one.
     pub mirror_check: Vec<MirrorCheck>,
+    /// How the roles were handed over at the jumps, and with fresh maps each start's pool.
+    pub boundary: Boundary,
+    pub fresh_pools: Vec<FreshPool>,
     pub costs: ExtrapolationCosts,
     /// `Σ C T` at `t1` and after the last period (J).
     pub total_heat_t1: f64,

@@ -5,6 +5,7 @@
 use super::{
     has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck, Notice, TableChoice,
 };
+use crate::boundary::{self, BoundaryMaps, Pool, PoolDraws};
 use crate::cache;
 use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
@@ -15,7 +16,7 @@ use crate::sidecar::{PairingSummary, StoredPairing};
 use crate::ExtrapolateError;
 use std::borrow::Cow;
 use std::time::Instant;
-use tdex_format::extrapolation::{PathPairing, RecurrencePath, Roles, Symmetry};
+use tdex_format::extrapolation::{Boundary, PathPairing, RecurrencePath, Roles, Symmetry};
 use tdex_format::{
     ExtrapolationCosts, ExtrapolationInfo, ExtrapolationWriter, RecordingInfo, RecordingReader,
     Snapshot, FORMAT_VERSION,
@@ -59,6 +60,10 @@ pub(super) struct Extrapolation<'a> {
     pairings: Vec<PathStart>,
     /// With the axial mirror: each start's mirrored pairing beside its plain one.
     mirror_check: Vec<MirrorCheck>,
+    /// The boundary maps, with the seed they are drawn from.
+    boundary: Boundary,
+    /// With fresh boundary maps: each start's pool of pairings.
+    pools: Vec<(u32, Pool)>,
     /// Wall time of the pairings computed (and stored) by this run.
     seconds_pairing: f64,
     /// Whether every pairing of the path was found stored (the mirror check's aside).
@@ -97,6 +102,11 @@ impl<'a> Extrapolation<'a> {
         }
         if request.symmetry == Symmetry::AxialMirror && !has_mirror_image(&info) {
             return Err(ExtrapolateError::NoMirrorImage {
+                recording: request.recording.clone(),
+            });
+        }
+        if request.boundary != BoundaryMaps::Exact && !has_mirror_image(&info) {
+            return Err(ExtrapolateError::NoDrumAxis {
                 recording: request.recording.clone(),
             });
         }
@@ -147,6 +157,8 @@ impl<'a> Extrapolation<'a> {
             rows_of,
             pairings: Vec::new(),
             mirror_check: Vec::new(),
+            boundary: request.boundary.with_seed(seed),
+            pools: Vec::new(),
             seconds_pairing: 0.0,
             pairing_reused: true,
             tables: Vec::new(),
@@ -213,7 +225,29 @@ impl<'a> Extrapolation<'a> {
         if self.request.symmetry == Symmetry::AxialMirror {
             self.mirror_check = self.check_mirror(notice)?;
         }
+        self.pools = self.fresh_pools()?;
         Ok(())
+    }
+
+    /// Each start's pool of fresh pairings (none for the exact boundary), from the last
+    /// period used (`t_{P'−1}` to `t_P'`, the period every jump leaves), each start's maps
+    /// drawn from a seed of its own. Computed every run: a pool costs `pool` pairings, which
+    /// is small beside a DEM period, and storing it would write `pool` sidecars per start.
+    fn fresh_pools(&mut self) -> Result<Vec<(u32, Pool)>, ExtrapolateError> {
+        let started = Instant::now();
+        let before = &self.snaps[self.used as usize - 1];
+        let mut pools = Vec::new();
+        for p in &self.pairings {
+            let start = start_image(&self.snaps, p.period, self.request.symmetry);
+            let seed = self.seed.wrapping_add(u64::from(p.period));
+            if let Some(pool) =
+                boundary::fresh_pool(self.request.boundary, before, self.end(), &start, seed)?
+            {
+                pools.push((p.period, pool));
+            }
+        }
+        self.seconds_pairing += started.elapsed().as_secs_f64();
+        Ok(pools)
     }
 
     /// The mirror holds only if the bed is its own mirror image at the recorded instants:
@@ -329,11 +363,13 @@ impl<'a> Extrapolation<'a> {
         // the recorded period whose end the output's positions are, and in which image
         let mut positions_of = (1, false);
         let mut next_id = Vec::with_capacity(out.id.len());
+        let mut pool_draws = PoolDraws::new(self.seed);
         let t = Instant::now();
         for ((k, step), &mirrored) in (1..=request.periods).zip(&self.steps).zip(&self.mirrored) {
             let p = step.period();
             if let Step::Jump { period } = *step {
-                let g = self.pairing_at_jump(period);
+                let drawn = draw_from_pool(self.boundary, &mut pool_draws);
+                let g = self.pairing_at_jump(period, drawn);
                 temps.move_to_roles(g, &mut next)?;
                 replay::move_to_roles(&out.id, g, &mut next_id)?;
                 std::mem::swap(&mut out.id, &mut next_id);
@@ -376,13 +412,23 @@ impl<'a> Extrapolation<'a> {
     }
 
     /// The pairing a jump into recorded period `period` moves the roles along: of the
-    /// recording's end to that period's start (or its image).
-    fn pairing_at_jump(&self, period: u32) -> &[u32] {
-        self.pairings
-            .iter()
-            .find(|p| p.period == period)
-            .map(|p| &p.stored.g[..])
-            .expect("a pairing for every start of the path")
+    /// recording's end to that period's start (or its image), the exact one or the pool's
+    /// `drawn`.
+    fn pairing_at_jump(&self, period: u32, drawn: Option<usize>) -> &[u32] {
+        match drawn {
+            None => self
+                .pairings
+                .iter()
+                .find(|p| p.period == period)
+                .map(|p| &p.stored.g[..])
+                .expect("a pairing for every start of the path"),
+            Some(m) => self
+                .pools
+                .iter()
+                .find(|(start, _)| *start == period)
+                .map(|(_, pool)| &pool.maps[m][..])
+                .expect("a pool for every start of the path"),
+        }
     }
 
     /// Applies the rows of recorded period `p` to the roles' temperatures, from its table in
@@ -435,6 +481,8 @@ impl<'a> Extrapolation<'a> {
             }),
             symmetry: request.symmetry,
             mirror_check: self.mirror_check.clone(),
+            boundary: self.boundary,
+            fresh_pools: self.fresh_pool_summaries(),
         }
     }
 
@@ -473,11 +521,18 @@ impl<'a> Extrapolation<'a> {
             limit: self.request.memory_limit.clone(),
             roles: self.roles(|s| s.summary.clone()),
             symmetry: self.request.symmetry,
+            boundary: self.boundary,
+            fresh_pools: self.fresh_pool_summaries(),
             mirror_check: self.mirror_check,
             costs: replayed.costs,
             total_heat_t1: replayed.total_heat_t1,
             total_heat_end: replayed.total_heat_end,
         }
+    }
+
+    /// Each start's pool of fresh pairings, told in the output and the outcome.
+    fn fresh_pool_summaries(&self) -> Vec<tdex_format::extrapolation::FreshPool> {
+        self.pools.iter().map(|(_, pool)| pool.summary).collect()
     }
 
     /// The recording's end `t_P'`, the snapshot every pairing of the path starts from.
@@ -518,6 +573,17 @@ fn jump_targets(
     let targets = path::distinct_ascending(targets);
     // every period as a target is the default path: nothing to record
     Ok((!targets.is_empty() && targets.len() < used as usize).then_some(targets))
+}
+
+/// Which pairing of its pool the next jump takes (`None` with the exact boundary, which
+/// draws nothing).
+fn draw_from_pool(boundary: Boundary, draws: &mut PoolDraws) -> Option<usize> {
+    match boundary {
+        Boundary::Exact => None,
+        Boundary::FreshSteps { pool, .. } | Boundary::FreshDrift { pool, .. } => {
+            Some(draws.next(pool as usize))
+        }
+    }
 }
 
 /// What a jump into recorded period `period` enters: its start itself, or its mirror image.

@@ -39,6 +39,13 @@ pub struct ExtrapolationInfo {
     /// the trust in the mirror goes. Absent without the mirror (and in the files before it).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub mirror_check: Vec<MirrorCheck>,
+    /// How the roles were handed over at the jumps; absent (the files before it) for the
+    /// exact pairing.
+    #[serde(default, skip_serializing_if = "Boundary::is_exact")]
+    pub boundary: Boundary,
+    /// With fresh boundary maps, each start's pool of pairings.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub fresh_pools: Vec<FreshPool>,
 }
 
 /// How far the axial mirror's pairing of `t_end` to the mirrored `t_start` moves the
@@ -113,6 +120,53 @@ impl Symmetry {
             to.copy_from_slice(from);
         }
     }
+}
+
+/// How the roles are handed over at each jump of the replay (docs/method.md §6).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Boundary {
+    /// One optimal pairing of the end to each start, the same at every jump: the paper's
+    /// method.
+    #[default]
+    Exact,
+    /// A pool of `pool` pairings per start, one drawn at each jump from `seed`, in each of
+    /// which every particle's step along the axis over the period just replayed is redrawn,
+    /// without replacement, among the particles ending in the same `cell_diameters`-wide cell
+    /// of the cross-section.
+    FreshSteps {
+        pool: u32,
+        cell_diameters: f64,
+        seed: u64,
+    },
+    /// A pool of `pool` pairings per start, one drawn at each jump from `seed`, in each of
+    /// which the period's coarse axial drift (bins of `bin_diameters` along the axis, cells of
+    /// `cell_diameters` across) is moved along the axis by a random offset.
+    FreshDrift {
+        pool: u32,
+        bin_diameters: f64,
+        cell_diameters: f64,
+        seed: u64,
+    },
+}
+
+impl Boundary {
+    pub fn is_exact(&self) -> bool {
+        *self == Boundary::Exact
+    }
+}
+
+/// The pool of fresh pairings to one start: how far its pairings move the particles, in
+/// particle diameters, beside the exact pairing of the same snapshots.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct FreshPool {
+    pub end: u32,
+    pub start: u32,
+    pub pairings: u32,
+    /// The pool's mean over particles and pairings, and its smallest and largest pairing's.
+    pub mean_distance_diameters: f64,
+    pub min_mean_distance_diameters: f64,
+    pub max_mean_distance_diameters: f64,
 }
 
 /// How an extrapolation moved the temperatures to their roles at the period boundaries.

@@ -1,0 +1,583 @@
+//! The boundary maps: how the roles are handed over at each jump of the replay, through one
+//! optimal pairing (the paper's method) or through a pool of fresh pairings in which the
+//! recorded period's displacement along the drum's axis is drawn again (docs/method.md §6).
+//!
+//! Why fresh maps: one recorded period replayed again and again applies the same particle map
+//! every period. Its random part (what this period's flow did beyond the mean flow) is then
+//! repeated, so its errors add up like the number of periods, where the DEM draws a new one
+//! each period and its own differences grow like the square root. Along the drum's axis the
+//! flow is the same everywhere (away from the end caps), so what the recorded period did at
+//! one place of the axis is as likely at another: moving it along the axis gives another
+//! period of the same flow. Two ways are kept, because they mend different things (measured
+//! in docs/validation.md#fresh-boundary-maps):
+//!
+//! - [`BoundaryMaps::FreshSteps`] redraws each particle's own axial step among the particles
+//!   ending in the same cell of the cross-section. The particles' axial dispersion stays the
+//!   recording's, and a particle no longer meets the same contacts (the hot mantle) on the
+//!   same short cycle of the pairing for ever; but neighbours part by about a step each
+//!   period, which mixes heat along the axis faster than the DEM does.
+//! - [`BoundaryMaps::FreshDrift`] keeps each particle's step and moves only the period's
+//!   coarse axial drift (the mean step of each bin of the axis in each cell of the
+//!   cross-section, beyond the cell's mean over the axis) by a random offset along the axis:
+//!   the drift the exact map repeats becomes a random walk, and neighbours stay neighbours.
+
+use crate::pairing::{self, PairingOptions};
+use crate::ExtrapolateError;
+use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::collections::BTreeMap;
+use tdex_format::extrapolation::FreshPool;
+use tdex_format::Snapshot;
+
+pub use tdex_format::extrapolation::Boundary;
+
+/// Pairings per start in a pool: 8 and 128 give the same medians as 32 within 0.01 on eight
+/// beds of `heated_drum` over 100 periods.
+pub const DEFAULT_POOL: u32 = 32;
+/// Width of the cross-section cells, in particle diameters: cells of 2 to 100 diameters
+/// move the redrawn steps' median by at most 0.03 on the same beds.
+pub const DEFAULT_CELL_DIAMETERS: f64 = 3.0;
+/// Length of the axial bins of the drift, in particle diameters.
+pub const DEFAULT_BIN_DIAMETERS: f64 = 2.0;
+
+/// The boundary maps an extrapolation asks for; the seed is the recurrence path's (the
+/// case's unless given), so that one seed names the whole extrapolation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BoundaryMaps {
+    /// One optimal pairing per start, the same at every jump: the paper's method.
+    Exact,
+    /// A pool of `pool` pairings per start, each particle's axial step redrawn among the
+    /// particles ending in its `cell_diameters`-wide cell of the cross-section.
+    FreshSteps { pool: u32, cell_diameters: f64 },
+    /// A pool of `pool` pairings per start, the coarse axial drift (bins of `bin_diameters`
+    /// along the axis, cells of `cell_diameters` across) moved along the axis.
+    FreshDrift {
+        pool: u32,
+        bin_diameters: f64,
+        cell_diameters: f64,
+    },
+}
+
+impl BoundaryMaps {
+    /// The boundary as the extrapolation file records it, with the seed it was drawn from.
+    pub fn with_seed(self, seed: u64) -> Boundary {
+        match self {
+            BoundaryMaps::Exact => Boundary::Exact,
+            BoundaryMaps::FreshSteps {
+                pool,
+                cell_diameters,
+            } => Boundary::FreshSteps {
+                pool,
+                cell_diameters,
+                seed,
+            },
+            BoundaryMaps::FreshDrift {
+                pool,
+                bin_diameters,
+                cell_diameters,
+            } => Boundary::FreshDrift {
+                pool,
+                bin_diameters,
+                cell_diameters,
+                seed,
+            },
+        }
+    }
+}
+
+/// The extent of the bed along the axis, `(lowest, highest)` `y`.
+fn axial_extent(pos: &[[f64; 3]]) -> (f64, f64) {
+    pos.iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p[1]), hi.max(p[1]))
+        })
+}
+
+/// A uniform number in `[0, 1)` from one 64-bit draw.
+fn unit(rng: &mut Xoshiro256PlusPlus) -> f64 {
+    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// The end positions of one map with fresh steps, for the period from `start` (`t_{p−1}`) to
+/// `end` (`t_p`): each particle keeps its recorded position across the drum (`x`, `z` at
+/// `t_p`); along the axis it takes its position at `t_{p−1}` plus the step of another
+/// particle, drawn without replacement among those ending in the same `cell`-wide square of
+/// the cross-section. The axial position stays within the bed's extent at `t_{p−1}` (a step
+/// drawn near an end cap that would cross it stops at the cap).
+pub fn fresh_step_ends(
+    start: &Snapshot,
+    end: &Snapshot,
+    cell: f64,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Vec<[f64; 3]> {
+    let (lowest, highest) = axial_extent(&start.pos);
+    let mut ends = end.pos.clone();
+    for members in cross_section_cells(&end.pos, cell).values() {
+        let mut donors = members.clone();
+        shuffle(&mut donors, rng);
+        for (&a, &b) in members.iter().zip(&donors) {
+            let step = end.pos[b][1] - start.pos[b][1];
+            ends[a][1] = (start.pos[a][1] + step).clamp(lowest, highest);
+        }
+    }
+    ends
+}
+
+/// The coarse axial drift of the period from `start` to `end`: for each `cell`-wide square
+/// of the cross-section (keyed as [`cross_section_cells`]), the mean axial step of the
+/// particles ending in each `bin`-long bin of the axis, less the square's mean over the
+/// axis (0 in an empty bin). What the exact map repeats at every period.
+pub fn axial_drift(
+    start: &Snapshot,
+    end: &Snapshot,
+    bin: f64,
+    cell: f64,
+) -> BTreeMap<(i64, i64), Vec<f64>> {
+    let (lowest, highest) = axial_extent(&end.pos);
+    let bins = (((highest - lowest) / bin).floor() as usize + 1).max(1);
+    cross_section_cells(&end.pos, cell)
+        .into_iter()
+        .map(|(key, members)| {
+            let mut sums = vec![(0.0, 0.0); bins];
+            let mut total = 0.0;
+            for &a in &members {
+                let step = end.pos[a][1] - start.pos[a][1];
+                let b = axial_bin(end.pos[a][1], lowest, bin, bins);
+                sums[b].0 += step;
+                sums[b].1 += 1.0;
+                total += step;
+            }
+            let mean = total / members.len() as f64;
+            let drift = sums
+                .iter()
+                .map(|&(sum, count)| if count > 0.0 { sum / count - mean } else { 0.0 })
+                .collect();
+            (key, drift)
+        })
+        .collect()
+}
+
+/// The bin of the axis, `bin` long from `lowest`, that `y` falls in (the last one for the
+/// highest particle).
+fn axial_bin(y: f64, lowest: f64, bin: f64, bins: usize) -> usize {
+    (((y - lowest) / bin).floor() as usize).min(bins - 1)
+}
+
+/// The end positions of one map with a fresh drift, for the period from `start` to `end`:
+/// each particle keeps its recorded end position but for its bin's drift, which becomes the
+/// drift of the bin a random offset further along the axis (the same offset for the whole
+/// bed, wrapped around its extent), so that the drift's pattern, and every particle's place
+/// among its neighbours, is the recording's. Positions stay within the bed's extent at the
+/// end.
+pub fn fresh_drift_ends(
+    start: &Snapshot,
+    end: &Snapshot,
+    bin: f64,
+    cell: f64,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Vec<[f64; 3]> {
+    let (lowest, highest) = axial_extent(&end.pos);
+    let bins = (((highest - lowest) / bin).floor() as usize + 1).max(1);
+    let drift = axial_drift(start, end, bin, cell);
+    let offset = ((unit(rng) * bins as f64) as usize).min(bins - 1);
+    let key = |p: &[f64; 3]| ((p[0] / cell).floor() as i64, (p[2] / cell).floor() as i64);
+    end.pos
+        .iter()
+        .map(|&[x, y, z]| {
+            let cell_drift = &drift[&key(&[x, y, z])];
+            let b = axial_bin(y, lowest, bin, bins);
+            let moved = y + cell_drift[(b + offset) % bins] - cell_drift[b];
+            [x, moved.clamp(lowest, highest), z]
+        })
+        .collect()
+}
+
+/// The particles ending in each `cell`-wide square of the cross-section (`x`, `z`), in
+/// index order within a square and squares in a fixed order: the shuffles, and so the maps,
+/// are a function of the seed alone.
+fn cross_section_cells(pos: &[[f64; 3]], cell: f64) -> BTreeMap<(i64, i64), Vec<usize>> {
+    let mut cells: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
+    for (a, p) in pos.iter().enumerate() {
+        let key = ((p[0] / cell).floor() as i64, (p[2] / cell).floor() as i64);
+        cells.entry(key).or_default().push(a);
+    }
+    cells
+}
+
+/// Fisher–Yates with Lemire's multiply-shift draw (as the recurrence path draws its starts):
+/// one 64-bit draw per element, whatever the values.
+fn shuffle(items: &mut [usize], rng: &mut Xoshiro256PlusPlus) {
+    for i in (1..items.len()).rev() {
+        let j = ((u128::from(rng.next_u64()) * (i as u128 + 1)) >> 64) as usize;
+        items.swap(i, j);
+    }
+}
+
+/// A pool of fresh pairings of one period's end to one start.
+#[derive(Debug, Clone)]
+pub struct Pool {
+    /// `maps[m][a]`: the role at the start that particle `a` takes, in pairing `m`.
+    pub maps: Vec<Vec<u32>>,
+    pub summary: FreshPool,
+}
+
+/// The pool of fresh pairings the boundary `maps` asks for (`None` for the exact one), of the
+/// period from `before` (`t_{p−1}`) to `end` (`t_p`) into `start` (the snapshot, or its
+/// image, a jump enters), drawn from `seed`.
+pub fn fresh_pool(
+    maps: BoundaryMaps,
+    before: &Snapshot,
+    end: &Snapshot,
+    start: &Snapshot,
+    seed: u64,
+) -> Result<Option<Pool>, ExtrapolateError> {
+    let d = start.mean_diameter();
+    let pool = match maps {
+        BoundaryMaps::Exact => return Ok(None),
+        BoundaryMaps::FreshSteps { pool, .. } | BoundaryMaps::FreshDrift { pool, .. } => pool,
+    };
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut pairings = Vec::with_capacity(pool as usize);
+    let mut means = Vec::with_capacity(pool as usize);
+    for _ in 0..pool {
+        let ends = match maps {
+            BoundaryMaps::Exact => unreachable!("no pool for the exact boundary"),
+            BoundaryMaps::FreshSteps { cell_diameters, .. } => {
+                fresh_step_ends(before, end, cell_diameters * d, &mut rng)
+            }
+            BoundaryMaps::FreshDrift {
+                bin_diameters,
+                cell_diameters,
+                ..
+            } => fresh_drift_ends(before, end, bin_diameters * d, cell_diameters * d, &mut rng),
+        };
+        let opts = PairingOptions::for_bed(d, &start.pos, &ends);
+        let p = pairing::pair(&start.pos, &ends, &opts)?;
+        means.push(p.mean_distance_in_diameters(d));
+        pairings.push(p.g);
+    }
+    let mean = means.iter().sum::<f64>() / means.len().max(1) as f64;
+    Ok(Some(Pool {
+        maps: pairings,
+        summary: FreshPool {
+            end: end.index,
+            start: start.index,
+            pairings: pool,
+            mean_distance_diameters: mean,
+            min_mean_distance_diameters: means.iter().copied().fold(f64::INFINITY, f64::min),
+            max_mean_distance_diameters: means.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+        },
+    }))
+}
+
+/// Which pairing of a pool each jump uses: a stream of its own, seeded from the boundary's
+/// seed, so that the recurrence path's draws (from the path seed) are the same with either
+/// boundary.
+#[derive(Debug, Clone)]
+pub struct PoolDraws {
+    rng: Xoshiro256PlusPlus,
+}
+
+impl PoolDraws {
+    pub fn new(seed: u64) -> Self {
+        // a stream 2^192 draws away from the pools' own, which start at seeds near `seed`
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        rng.long_jump();
+        Self { rng }
+    }
+
+    /// One of `0..pool`, uniformly (Lemire's multiply-shift, as [`shuffle`]).
+    pub fn next(&mut self, pool: usize) -> usize {
+        ((u128::from(self.rng.next_u64()) * pool as u128) >> 64) as usize
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn snapshot(index: u32, pos: Vec<[f64; 3]>) -> Snapshot {
+        let n = pos.len();
+        Snapshot {
+            index,
+            time: f64::from(index),
+            id: (0..n as u32).collect(),
+            pos,
+            radius: vec![0.5; n],
+            vel: vec![[0.0; 3]; n],
+            temp: vec![300.0; n],
+        }
+    }
+
+    /// A uniform number in `[-0.5, 0.5)`.
+    fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
+        (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    }
+
+    /// A random bed of unit spheres' centres, one per unit volume, in a box `wx × wy × wz`.
+    fn random_bed(n: usize, (wx, wy, wz): (f64, f64, f64), seed: u64) -> Vec<[f64; 3]> {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+        (0..n)
+            .map(|_| {
+                [
+                    wx * (uniform(&mut rng) + 0.5),
+                    wy * (uniform(&mut rng) + 0.5),
+                    wz * (uniform(&mut rng) + 0.5),
+                ]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn fresh_steps_keep_the_cross_section_and_redraw_each_cells_axial_steps() {
+        let mut start_pos = random_bed(2000, (10.0, 50.0, 4.0), 1);
+        // two particles far along the axis, alone in their cell, so that no step is clamped
+        start_pos.push([100.0, -100.0, 100.0]);
+        start_pos.push([100.0, 200.0, 100.0]);
+        let start = snapshot(0, start_pos);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(2);
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut().take(2000) {
+            p[0] += uniform(&mut rng);
+            p[1] += 3.0 * uniform(&mut rng);
+            p[2] += uniform(&mut rng);
+        }
+        let end = snapshot(1, end_pos);
+        let ends = fresh_step_ends(&start, &end, 2.0, &mut rng);
+        let mut redrawn = 0;
+        for members in cross_section_cells(&end.pos, 2.0).values() {
+            let sorted = |mut steps: Vec<f64>| {
+                steps.sort_by(f64::total_cmp);
+                steps
+            };
+            let recorded = sorted(
+                members
+                    .iter()
+                    .map(|&a| end.pos[a][1] - start.pos[a][1])
+                    .collect(),
+            );
+            let drawn = sorted(
+                members
+                    .iter()
+                    .map(|&a| ends[a][1] - start.pos[a][1])
+                    .collect(),
+            );
+            for (r, d) in recorded.iter().zip(&drawn) {
+                assert!((r - d).abs() < 1e-9, "steps {r} and {d}");
+            }
+            for &a in members {
+                assert_eq!([ends[a][0], ends[a][2]], [end.pos[a][0], end.pos[a][2]]);
+                redrawn += usize::from(ends[a][1] != end.pos[a][1]);
+            }
+        }
+        assert!(redrawn > 1500, "only {redrawn} of 2000 steps redrawn");
+    }
+
+    #[test]
+    fn a_step_that_would_cross_an_end_cap_stops_at_it() {
+        let start = snapshot(0, vec![[0.0, 0.0, 0.0], [0.0, 10.0, 0.0]]);
+        let end = snapshot(1, vec![[0.0, -5.0, 0.0], [0.0, 15.0, 0.0]]);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        for _ in 0..8 {
+            let ends = fresh_step_ends(&start, &end, 3.0, &mut rng);
+            assert!(
+                ends.iter().all(|p| (0.0..=10.0).contains(&p[1])),
+                "{ends:?}"
+            );
+        }
+    }
+
+    /// The calibration: on a synthetic bed whose recorded period moves one half of the
+    /// cross-section (`x < 4`) along the axis by +1.5 and the other by −1.5, each particle with
+    /// an independent step of its own besides, the exact pairing repeated carries that
+    /// counterflow again every period (its mean square displacement grows like k²). Redrawn
+    /// across the whole cross-section, the fresh maps make it a random walk at the recorded
+    /// steps' own mean square (it grows like k); redrawn within cells that separate the two
+    /// halves, they keep it, as they keep the flow's mean at every place of the cross-section.
+    #[test]
+    fn fresh_maps_recover_the_recorded_axial_dispersion_where_the_exact_map_drifts() {
+        let start = snapshot(0, random_bed(3000, (8.0, 120.0, 3.0), 3));
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(4);
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut() {
+            let drift = if p[0] < 4.0 { 1.5 } else { -1.5 };
+            p[1] += drift + 4.0 * uniform(&mut rng);
+        }
+        let end = snapshot(1, end_pos);
+        let y0: Vec<f64> = start.pos.iter().map(|p| p[1]).collect();
+        let recorded = (0..y0.len())
+            .map(|a| (end.pos[a][1] - y0[a]).powi(2))
+            .sum::<f64>()
+            / y0.len() as f64;
+        // the axial mean square displacement of the heat after `k` periods, over the parcels
+        // starting in the middle (the ends, 40 away, confine none of them): a parcel starting
+        // at role a is at role map_k(…map_1(a)) of the start
+        let msd_after = |map: &mut dyn FnMut() -> Vec<u32>, k: usize| {
+            let mid: Vec<usize> = (0..y0.len())
+                .filter(|&a| (40.0..80.0).contains(&y0[a]))
+                .collect();
+            let mut role = mid.clone();
+            for _ in 0..k {
+                let g = map();
+                for r in role.iter_mut() {
+                    *r = g[*r] as usize;
+                }
+            }
+            mid.iter()
+                .zip(&role)
+                .map(|(&a, &r)| (y0[r] - y0[a]).powi(2))
+                .sum::<f64>()
+                / mid.len() as f64
+        };
+        let d = start.mean_diameter();
+        let exact = pairing::pair(
+            &start.pos,
+            &end.pos,
+            &PairingOptions::for_bed(d, &start.pos, &end.pos),
+        )
+        .unwrap()
+        .g;
+        let k = 10;
+        let fresh_msd = |cell: f64| {
+            let steps = BoundaryMaps::FreshSteps {
+                pool: 16,
+                cell_diameters: cell / d,
+            };
+            let pool = fresh_pool(steps, &start, &end, &start, 3).unwrap().unwrap();
+            let mut draws = PoolDraws::new(3);
+            msd_after(&mut || pool.maps[draws.next(16)].clone(), k)
+        };
+        let exact_msd = msd_after(&mut || exact.clone(), k);
+        let across = fresh_msd(100.0);
+        let within_halves = fresh_msd(4.0);
+        let random_walk = k as f64 * recorded;
+        assert!(
+            (0.8..1.25).contains(&(across / random_walk)),
+            "fresh {across}, a random walk at the recorded rate {random_walk}"
+        );
+        // the counterflow alone moves a parcel 15 in 10 periods: 225 beside the walk's 36
+        assert!(
+            exact_msd > 4.0 * across,
+            "exact {exact_msd}, fresh {across}"
+        );
+        assert!(
+            within_halves > 4.0 * across,
+            "fresh within the halves {within_halves}, across {across}"
+        );
+    }
+
+    #[test]
+    fn the_drift_is_each_bins_mean_step_beyond_its_cells_mean() {
+        // one cell of the cross-section; bins of 2 along the axis from the lowest end, y = 0
+        let at = |ys: [f64; 4]| ys.iter().map(|&y| [0.5, y, 0.5]).collect::<Vec<_>>();
+        let start = snapshot(0, at([-1.0, 0.5, 3.0, 5.0]));
+        let end = snapshot(1, at([0.0, 1.5, 2.5, 5.0]));
+        // steps 1, 1, −0.5, 0 (mean 0.375); ends in bins 0, 0, 1, 2
+        let drift = axial_drift(&start, &end, 2.0, 3.0);
+        assert_eq!(drift.len(), 1);
+        let bins = &drift[&(0, 0)];
+        let expected = [1.0 - 0.375, -0.5 - 0.375, 0.0 - 0.375];
+        assert_eq!(bins.len(), 3);
+        for (b, e) in bins.iter().zip(expected) {
+            assert!((b - e).abs() < 1e-12, "{bins:?}");
+        }
+    }
+
+    /// A fresh drift moves every particle of a bin (in one cell of the cross-section) by the
+    /// same amount, the drift of the bin one offset further less its own: the drift's
+    /// pattern is the recording's, moved along the axis, and neighbours stay neighbours.
+    #[test]
+    fn a_fresh_drift_moves_each_bin_as_one_by_the_drift_of_another() {
+        let start = snapshot(0, random_bed(3000, (8.0, 60.0, 3.0), 7));
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut() {
+            // a drift that changes sign every 6 along the axis, and particle steps
+            let drift = if (p[1] / 6.0).floor() as i64 % 2 == 0 {
+                0.8
+            } else {
+                -0.8
+            };
+            p[1] = (p[1] + drift + uniform(&mut rng)).clamp(0.0, 60.0);
+        }
+        let end = snapshot(1, end_pos);
+        let (bin, cell) = (2.0, 4.0);
+        let drift = axial_drift(&start, &end, bin, cell);
+        let spread = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
+        let mut offsets_seen = std::collections::BTreeSet::new();
+        for _ in 0..6 {
+            let ends = fresh_drift_ends(&start, &end, bin, cell, &mut rng);
+            let (lowest, highest) = axial_extent(&end.pos);
+            let bins = ((highest - lowest) / bin).floor() as usize + 1;
+            let mut moved_by: BTreeMap<((i64, i64), usize), f64> = BTreeMap::new();
+            for (a, e) in end.pos.iter().enumerate() {
+                assert_eq!([ends[a][0], ends[a][2]], [e[0], e[2]]);
+                let key = ((e[0] / cell).floor() as i64, (e[2] / cell).floor() as i64);
+                let b = axial_bin(e[1], lowest, bin, bins);
+                let by = ends[a][1] - e[1];
+                let unclamped = (lowest..=highest).contains(&(e[1] + by))
+                    && ends[a][1] > lowest
+                    && ends[a][1] < highest;
+                if unclamped {
+                    let first = *moved_by.entry((key, b)).or_insert(by);
+                    assert!((first - by).abs() < 1e-12, "a bin moved apart");
+                }
+            }
+            // the one offset: every cell's bins moved by drift[b + o] − drift[b]
+            let cell0 = &drift[&(0, 0)];
+            let offset = (0..bins)
+                .find(|&o| {
+                    moved_by
+                        .iter()
+                        .filter(|((k, _), _)| *k == (0, 0))
+                        .all(|((_, b), by)| (cell0[(b + o) % bins] - cell0[*b] - by).abs() < 1e-9)
+                })
+                .expect("one offset explains every bin's move");
+            offsets_seen.insert(offset);
+        }
+        assert!(
+            offsets_seen.len() > 1,
+            "the offset is drawn: {offsets_seen:?}"
+        );
+        // the recorded drift carries the ±0.8 pattern: each bin's drift is far from 0
+        assert!(spread(&drift[&(0, 0)]) > 0.3, "{:?}", drift[&(0, 0)]);
+    }
+
+    #[test]
+    fn the_pool_is_a_function_of_the_seed_and_its_maps_are_permutations() {
+        let start = snapshot(0, random_bed(500, (6.0, 30.0, 3.0), 5));
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(6);
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut() {
+            p[1] += 3.0 * uniform(&mut rng);
+        }
+        let end = snapshot(1, end_pos);
+        let steps = BoundaryMaps::FreshSteps {
+            pool: 4,
+            cell_diameters: 3.0,
+        };
+        let pool = |seed| {
+            fresh_pool(steps, &start, &end, &start, seed)
+                .unwrap()
+                .unwrap()
+        };
+        let (one, again, other) = (pool(9), pool(9), pool(10));
+        assert!(fresh_pool(BoundaryMaps::Exact, &start, &end, &start, 9)
+            .unwrap()
+            .is_none());
+        assert_eq!(one.maps, again.maps);
+        assert_ne!(one.maps, other.maps);
+        assert_ne!(one.maps[0], one.maps[1]);
+        for g in &one.maps {
+            let mut seen = vec![false; g.len()];
+            for &r in g {
+                assert!(!std::mem::replace(&mut seen[r as usize], true));
+            }
+        }
+        let mut a = PoolDraws::new(9);
+        let mut b = PoolDraws::new(9);
+        let drawn: Vec<usize> = (0..50).map(|_| a.next(4)).collect();
+        assert_eq!(drawn, (0..50).map(|_| b.next(4)).collect::<Vec<_>>());
+        assert!((0..4).all(|m| drawn.contains(&m)));
+    }
+}

@@ -1,0 +1,293 @@
+//! `tdex extrapolate --boundary`: the fresh boundary maps conserve the heat over 500 periods,
+//! are the same bytes on any thread count and a function of the seed, say what they did, and
+//! work along a recurrence path; `--boundary exact` is the paper's method to the byte; the
+//! fresh maps' options are refused without them.
+
+use crate::cli_run::TINY_CASE;
+use crate::util::{run_tdex, tdex_ok};
+use std::path::{Path, PathBuf};
+
+/// The tiny drum heated by its mantle, recorded with τ = 0.2 s (a tenth of a revolution) and
+/// `periods` recorded periods, reproducibly.
+fn heated_recording(dir: &Path, periods: &str) -> PathBuf {
+    let case = dir.join("tiny.toml");
+    let heated = TINY_CASE.replace(
+        "rotation_period = 2.0",
+        "rotation_period = 2.0\nwall_temperature = 350.0",
+    );
+    std::fs::write(&case, heated).unwrap();
+    let run = dir.join("run.mcap");
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        run.to_str().unwrap(),
+        "--tau",
+        "0.2",
+        "--recorded-periods",
+        periods,
+        "--reproducible",
+    ]);
+    run
+}
+
+/// `tdex extrapolate RUN -o OUT --reproducible --json` with `flags`: the summary.
+fn extrapolate(run: &Path, out: &Path, flags: &[&str]) -> serde_json::Value {
+    let mut args = vec![
+        "extrapolate",
+        run.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--reproducible",
+        "--json",
+    ];
+    args.extend_from_slice(flags);
+    serde_json::from_str(&tdex_ok(&args)).unwrap()
+}
+
+#[test]
+fn fresh_maps_conserve_the_heat_over_500_periods_and_are_a_function_of_the_seed() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = heated_recording(dir.path(), "1");
+    let mut files = Vec::new();
+    for threads in ["1", "2"] {
+        let out = dir.path().join(format!("fresh{threads}.mcap"));
+        let report = extrapolate(
+            &run,
+            &out,
+            &[
+                "--periods",
+                "500",
+                "--boundary",
+                "fresh-steps",
+                "--threads",
+                threads,
+            ],
+        );
+        assert_eq!(report["boundary"]["kind"], "fresh_steps");
+        assert_eq!(report["boundary"]["pool"], 32);
+        assert_eq!(report["boundary"]["cell_diameters"], 3.0);
+        assert_eq!(report["boundary"]["seed"], 5, "the case's seed");
+        let pool = &report["fresh_pools"][0];
+        assert_eq!(
+            (pool["end"].as_u64(), pool["start"].as_u64()),
+            (Some(1), Some(0))
+        );
+        assert!(pool["mean_distance_diameters"].as_f64().unwrap() > 0.0);
+        files.push(std::fs::read(&out).unwrap());
+    }
+    assert!(files[0] == files[1], "the fresh maps depend on the threads");
+
+    // every jump is a permutation of the roles, and the rows exchange heat pairwise: on the
+    // same drum without the heated mantle, Σ C T after 500 periods of fresh maps is the one
+    // at t1
+    let adiabatic_dir = tempfile::tempdir().unwrap();
+    let case = adiabatic_dir.path().join("tiny.toml");
+    std::fs::write(&case, TINY_CASE).unwrap();
+    let adiabatic = adiabatic_dir.path().join("run.mcap");
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        adiabatic.to_str().unwrap(),
+        "--tau",
+        "0.2",
+        "--reproducible",
+    ]);
+    for kind in ["fresh-steps", "fresh-drift"] {
+        let mut files = Vec::new();
+        for threads in ["1", "2"] {
+            let out = adiabatic_dir.path().join(format!("{kind}{threads}.mcap"));
+            let report = extrapolate(
+                &adiabatic,
+                &out,
+                &["--periods", "500", "--boundary", kind, "--threads", threads],
+            );
+            let (t1, end) = (
+                report["total_heat_t1"].as_f64().unwrap(),
+                report["total_heat_end"].as_f64().unwrap(),
+            );
+            assert!(
+                ((end - t1) / t1).abs() < 1e-12,
+                "{kind}: heat {t1} J at t1, {end} J after 500 periods"
+            );
+            files.push(std::fs::read(&out).unwrap());
+        }
+        assert!(files[0] == files[1], "{kind} depends on the threads");
+    }
+    let drift = extrapolate(
+        &adiabatic,
+        &adiabatic_dir.path().join("drift.mcap"),
+        &[
+            "--periods",
+            "3",
+            "--boundary",
+            "fresh-drift",
+            "--boundary-bin",
+            "1.5",
+        ],
+    );
+    assert_eq!(drift["boundary"]["kind"], "fresh_drift");
+    assert_eq!(drift["boundary"]["bin_diameters"], 1.5);
+    assert_eq!(drift["boundary"]["cell_diameters"], 3.0);
+
+    // another seed draws other maps; the same seed the same bytes
+    let seeded = |seed: &str, name: &str| {
+        let out = dir.path().join(name);
+        let report = extrapolate(
+            &run,
+            &out,
+            &[
+                "--periods",
+                "500",
+                "--boundary",
+                "fresh-steps",
+                "--seed",
+                seed,
+            ],
+        );
+        assert_eq!(
+            report["boundary"]["seed"].as_u64().unwrap().to_string(),
+            seed
+        );
+        std::fs::read(out).unwrap()
+    };
+    assert!(
+        seeded("5", "s5.mcap") == files[0],
+        "--seed 5 is the case's seed"
+    );
+    assert!(
+        seeded("6", "s6.mcap") != files[0],
+        "another seed, the same maps"
+    );
+}
+
+#[test]
+fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need_fresh() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = heated_recording(dir.path(), "1");
+    let exact = dir.path().join("exact.mcap");
+    let paper = dir.path().join("paper.mcap");
+    let fresh = dir.path().join("fresh.mcap");
+    let e = extrapolate(&run, &exact, &["--periods", "20", "--boundary", "exact"]);
+    let p = extrapolate(&run, &paper, &["--periods", "20"]);
+    extrapolate(
+        &run,
+        &fresh,
+        &[
+            "--periods",
+            "20",
+            "--boundary",
+            "fresh-steps",
+            "--boundary-pool",
+            "4",
+            "--boundary-cell",
+            "2",
+        ],
+    );
+    let exact_bytes = std::fs::read(&exact).unwrap();
+    assert!(exact_bytes == std::fs::read(&paper).unwrap());
+    assert!(exact_bytes != std::fs::read(&fresh).unwrap());
+    // the exact boundary writes no boundary key (the files before it had none)
+    for report in [&e, &p] {
+        assert!(report.get("boundary").is_none() && report.get("fresh_pools").is_none());
+    }
+    let key = b"fresh_steps";
+    assert!(!exact_bytes.windows(key.len()).any(|w| w == key));
+    let inspected = tdex_ok(&["inspect", fresh.to_str().unwrap(), "--json"]);
+    assert!(inspected.contains("fresh_steps"), "{inspected}");
+
+    // the printed summary says what the jumps drew from
+    let printed = tdex_ok(&[
+        "extrapolate",
+        run.to_str().unwrap(),
+        "-o",
+        dir.path().join("printed.mcap").to_str().unwrap(),
+        "--periods",
+        "3",
+        "--boundary",
+        "fresh-steps",
+    ]);
+    assert!(
+        printed.contains("boundary      fresh steps: each jump draws one of 32 pairings")
+            && printed.contains("boundary      t1 to t0: 32 pairings, mean distance"),
+        "{printed}"
+    );
+
+    // the pool, the cell and the bin belong to the fresh maps, the bin to the drift
+    let refused_output = dir.path().join("refused.mcap");
+    let refused = |flags: &[&str], says: &str| {
+        let mut args = vec![
+            "extrapolate",
+            run.to_str().unwrap(),
+            "-o",
+            refused_output.to_str().unwrap(),
+            "--periods",
+            "3",
+        ];
+        args.extend_from_slice(flags);
+        let out = run_tdex(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(err.contains(says), "{err}");
+    };
+    for flag in [
+        ["--boundary-pool", "4"],
+        ["--boundary-cell", "2"],
+        ["--boundary-bin", "2"],
+    ] {
+        refused(
+            &flag,
+            "with --boundary exact there is one pairing per start",
+        );
+    }
+    refused(
+        &["--boundary", "fresh-steps", "--boundary-bin", "2"],
+        "--boundary-bin sets the bins of --boundary fresh-drift",
+    );
+    let out = run_tdex(&[
+        "extrapolate",
+        run.to_str().unwrap(),
+        "-o",
+        dir.path().join("refused.mcap").to_str().unwrap(),
+        "--periods",
+        "3",
+        "--boundary",
+        "fresh-steps",
+        "--boundary-pool",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!dir.path().join("refused.mcap").exists());
+}
+
+#[test]
+fn a_path_through_two_recorded_periods_draws_fresh_maps_into_each_start() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = heated_recording(dir.path(), "2");
+    for kind in ["fresh-steps", "fresh-drift"] {
+        let mut files = Vec::new();
+        for threads in ["1", "2"] {
+            let out = dir.path().join(format!("path{threads}.mcap"));
+            let report = extrapolate(
+                &run,
+                &out,
+                &["--periods", "40", "--boundary", kind, "--threads", threads],
+            );
+            let pools = report["fresh_pools"].as_array().unwrap();
+            let starts: Vec<u64> = pools.iter().map(|p| p["start"].as_u64().unwrap()).collect();
+            assert_eq!(starts, [0, 1], "a pool into each start the path enters");
+            assert!(pools.iter().all(|p| p["end"] == 2));
+            let (t1, end) = (
+                report["total_heat_t1"].as_f64().unwrap(),
+                report["total_heat_end"].as_f64().unwrap(),
+            );
+            assert!(end > t1, "the mantle heats the bed: {t1} J, then {end} J");
+            files.push(std::fs::read(&out).unwrap());
+        }
+        assert!(
+            files[0] == files[1],
+            "{kind} along the path depends on the threads"
+        );
+    }
+}
