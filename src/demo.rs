@@ -65,12 +65,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         extra.clone(),
         extrapolation::memory_limit(None),
     );
-    let outcome = crate::with_workers(plan.threads, || {
-        Ok(extrapolate::extrapolate_recording(
-            &request,
-            extrapolation::tell,
-        )?)
-    })?;
+    let outcome = extrapolation::extrapolate_on(plan.threads, &request)?;
     extrapolation::print(&request, outcome, false)?;
 
     println!("3/4 compare   against the DEM reference and its twin");

@@ -290,6 +290,17 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
     print(&request, outcome, plan.json)
 }
 
+/// Extrapolates `request` on `threads` workers, its notices told on stderr (the demo and the
+/// studies: their own context, not `tdex extrapolate`'s advice about flags).
+pub fn extrapolate_on(
+    threads: usize,
+    request: &ExtrapolationRequest,
+) -> Result<ExtrapolationOutcome> {
+    crate::with_workers(threads, || {
+        Ok(extrapolate::extrapolate_recording(request, tell)?)
+    })
+}
+
 /// The memory an extrapolation may use: `--max-memory` when given, else a share of what the
 /// machine has (and how to change it).
 pub fn memory_limit(max_memory: Option<u64>) -> MemoryLimit {

@@ -31,17 +31,21 @@ fn heated_recording(dir: &Path, periods: &str) -> PathBuf {
     run
 }
 
-/// `tdex extrapolate RUN -o OUT --reproducible --json` with `flags`: the summary.
-fn extrapolate(run: &Path, out: &Path, flags: &[&str]) -> serde_json::Value {
+/// The arguments of `tdex extrapolate RUN -o OUT` with `flags`.
+fn extrapolate_args<'a>(run: &'a Path, out: &'a Path, flags: &[&'a str]) -> Vec<&'a str> {
     let mut args = vec![
         "extrapolate",
         run.to_str().unwrap(),
         "-o",
         out.to_str().unwrap(),
-        "--reproducible",
-        "--json",
     ];
     args.extend_from_slice(flags);
+    args
+}
+
+/// `tdex extrapolate RUN -o OUT --reproducible --json` with `flags`: the summary.
+fn extrapolate(run: &Path, out: &Path, flags: &[&str]) -> serde_json::Value {
+    let args = extrapolate_args(run, out, &[&["--reproducible", "--json"], flags].concat());
     serde_json::from_str(&tdex_ok(&args)).unwrap()
 }
 
@@ -198,16 +202,12 @@ fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need
     assert!(inspected.contains("fresh_steps"), "{inspected}");
 
     // the printed summary says what the jumps drew from
-    let printed = tdex_ok(&[
-        "extrapolate",
-        run.to_str().unwrap(),
-        "-o",
-        dir.path().join("printed.mcap").to_str().unwrap(),
-        "--periods",
-        "3",
-        "--boundary",
-        "fresh-steps",
-    ]);
+    let printed_output = dir.path().join("printed.mcap");
+    let printed = tdex_ok(&extrapolate_args(
+        &run,
+        &printed_output,
+        &["--periods", "3", "--boundary", "fresh-steps"],
+    ));
     assert!(
         printed.contains("boundary      fresh steps: each jump draws one of 32 pairings")
             && printed.contains("boundary      t1 to t0: 32 pairings, mean distance"),
@@ -217,15 +217,11 @@ fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need
     // the pool, the cell and the bin belong to the fresh maps, the bin to the drift
     let refused_output = dir.path().join("refused.mcap");
     let refused = |flags: &[&str], says: &str| {
-        let mut args = vec![
-            "extrapolate",
-            run.to_str().unwrap(),
-            "-o",
-            refused_output.to_str().unwrap(),
-            "--periods",
-            "3",
-        ];
-        args.extend_from_slice(flags);
+        let args = extrapolate_args(
+            &run,
+            &refused_output,
+            &[&["--periods", "3"], flags].concat(),
+        );
         let out = run_tdex(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{err}");
@@ -245,20 +241,20 @@ fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need
         &["--boundary", "fresh-steps", "--boundary-bin", "2"],
         "--boundary-bin sets the bins of --boundary fresh-drift",
     );
-    let out = run_tdex(&[
-        "extrapolate",
-        run.to_str().unwrap(),
-        "-o",
-        dir.path().join("refused.mcap").to_str().unwrap(),
-        "--periods",
-        "3",
-        "--boundary",
-        "fresh-steps",
-        "--boundary-pool",
-        "0",
-    ]);
+    let out = run_tdex(&extrapolate_args(
+        &run,
+        &refused_output,
+        &[
+            "--periods",
+            "3",
+            "--boundary",
+            "fresh-steps",
+            "--boundary-pool",
+            "0",
+        ],
+    ));
     assert_eq!(out.status.code(), Some(2));
-    assert!(!dir.path().join("refused.mcap").exists());
+    assert!(!refused_output.exists());
 }
 
 #[test]
