@@ -200,6 +200,23 @@ fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need
     assert!(!exact_bytes.windows(key.len()).any(|w| w == key));
     let inspected = tdex_ok(&["inspect", fresh.to_str().unwrap(), "--json"]);
     assert!(inspected.contains("fresh_steps"), "{inspected}");
+    // the report's table of the run says what each jump drew from, and only then
+    for (extra, says) in [(&fresh, true), (&exact, false)] {
+        let report = dir.path().join("report");
+        tdex_ok(&[
+            "report",
+            run.to_str().unwrap(),
+            extra.to_str().unwrap(),
+            "-o",
+            report.to_str().unwrap(),
+        ]);
+        let md = std::fs::read_to_string(report.join("report.md")).unwrap();
+        assert_eq!(
+            md.contains("Boundary maps") && md.contains("fresh steps: each jump draws one of 4"),
+            says,
+            "{md}"
+        );
+    }
 
     // the printed summary says what the jumps drew from
     let printed_output = dir.path().join("printed.mcap");

@@ -416,6 +416,17 @@ pub fn document(inp: &Inputs) -> Document {
                     .join("; "),
             )
         }))
+        // with fresh boundary maps, what each jump drew from
+        .chain((!inp.extrapolation.boundary.is_exact()).then(|| {
+            row(
+                "Boundary maps",
+                crate::extrapolation::boundary_lines(
+                    inp.extrapolation.boundary,
+                    &inp.extrapolation.fresh_pools,
+                )
+                .join("; "),
+            )
+        }))
         .chain(c.map(|c| row("Voronoi cells", format!("{} (seed {})", c.cells, c.seed))))
         .chain(p.lacey_cells.map(|n| {
             row(
