@@ -37,7 +37,8 @@ pub const DEFAULT_POOL: u32 = 32;
 /// Width of the cross-section cells, in particle diameters: cells of 2 to 100 diameters
 /// move the redrawn steps' median by at most 0.03 on the same beds.
 pub const DEFAULT_CELL_DIAMETERS: f64 = 3.0;
-/// Length of the axial bins of the drift, in particle diameters.
+/// Length of the axial bins of the drift, in particle diameters: bins of 2 and 4 diameters
+/// (over the whole cross-section) gave 1.01 and 1.03 on two beds of `axial_drum`.
 pub const DEFAULT_BIN_DIAMETERS: f64 = 2.0;
 
 /// The boundary maps an extrapolation asks for; the seed is the recurrence path's (the
