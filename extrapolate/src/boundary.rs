@@ -111,9 +111,19 @@ pub fn fresh_step_ends(
     cell: f64,
     rng: &mut Xoshiro256PlusPlus,
 ) -> Vec<[f64; 3]> {
+    step_ends(start, end, &cross_section_cells(&end.pos, cell), rng)
+}
+
+/// [`fresh_step_ends`] with the cross-section's cells found once for the whole pool.
+fn step_ends(
+    start: &Snapshot,
+    end: &Snapshot,
+    cells: &BTreeMap<(i64, i64), Vec<usize>>,
+    rng: &mut Xoshiro256PlusPlus,
+) -> Vec<[f64; 3]> {
     let (lowest, highest) = axial_extent(&start.pos);
     let mut ends = end.pos.clone();
-    for members in cross_section_cells(&end.pos, cell).values() {
+    for members in cells.values() {
         let mut donors = members.clone();
         shuffle(&mut donors, rng);
         for (&a, &b) in members.iter().zip(&donors) {
@@ -126,71 +136,77 @@ pub fn fresh_step_ends(
 
 /// The coarse axial drift of the period from `start` to `end`: for each `cell`-wide square
 /// of the cross-section (keyed as [`cross_section_cells`]), the mean axial step of the
-/// particles ending in each `bin`-long bin of the axis, less the square's mean over the
-/// axis (0 in an empty bin). What the exact map repeats at every period.
-pub fn axial_drift(
-    start: &Snapshot,
-    end: &Snapshot,
+/// particles ending in each `bin`-long bin of the axis (from the lowest end), less the
+/// square's mean over the axis (0 in an empty bin). What the exact map repeats at every
+/// period.
+#[derive(Debug, Clone)]
+pub struct AxialDrift {
+    /// The bed's extent along the axis at the end, `(lowest, highest)` `y`.
+    extent: (f64, f64),
     bin: f64,
+    bins: usize,
     cell: f64,
-) -> BTreeMap<(i64, i64), Vec<f64>> {
-    let (lowest, highest) = axial_extent(&end.pos);
-    let bins = (((highest - lowest) / bin).floor() as usize + 1).max(1);
-    cross_section_cells(&end.pos, cell)
-        .into_iter()
-        .map(|(key, members)| {
+    pub by_cell: BTreeMap<(i64, i64), Vec<f64>>,
+}
+
+impl AxialDrift {
+    pub fn of(start: &Snapshot, end: &Snapshot, bin: f64, cell: f64) -> Self {
+        let extent = axial_extent(&end.pos);
+        let bins = (((extent.1 - extent.0) / bin).floor() as usize + 1).max(1);
+        let mut drift = Self {
+            extent,
+            bin,
+            bins,
+            cell,
+            by_cell: BTreeMap::new(),
+        };
+        for (key, members) in cross_section_cells(&end.pos, cell) {
             let mut sums = vec![(0.0, 0.0); bins];
             let mut total = 0.0;
             for &a in &members {
                 let step = end.pos[a][1] - start.pos[a][1];
-                let b = axial_bin(end.pos[a][1], lowest, bin, bins);
+                let b = drift.bin_of(end.pos[a][1]);
                 sums[b].0 += step;
                 sums[b].1 += 1.0;
                 total += step;
             }
             let mean = total / members.len() as f64;
-            let drift = sums
+            let by_bin = sums
                 .iter()
                 .map(|&(sum, count)| if count > 0.0 { sum / count - mean } else { 0.0 })
                 .collect();
-            (key, drift)
-        })
-        .collect()
+            drift.by_cell.insert(key, by_bin);
+        }
+        drift
+    }
+
+    /// The bin of the axis `y` falls in (the last one for the highest particle).
+    fn bin_of(&self, y: f64) -> usize {
+        (((y - self.extent.0) / self.bin).floor() as usize).min(self.bins - 1)
+    }
+
+    /// The end positions of one map with a fresh drift: each particle keeps its recorded end
+    /// position but for its bin's drift, which becomes the drift of the bin a random offset
+    /// further along the axis (the same offset for the whole bed, wrapped around its extent),
+    /// so that the drift's pattern, and every particle's place among its neighbours, is the
+    /// recording's. Positions stay within the bed's extent at the end.
+    pub fn moved_ends(&self, end: &Snapshot, rng: &mut Xoshiro256PlusPlus) -> Vec<[f64; 3]> {
+        let offset = ((unit(rng) * self.bins as f64) as usize).min(self.bins - 1);
+        end.pos
+            .iter()
+            .map(|&[x, y, z]| {
+                let cell_drift = &self.by_cell[&cell_key(&[x, y, z], self.cell)];
+                let b = self.bin_of(y);
+                let moved = y + cell_drift[(b + offset) % self.bins] - cell_drift[b];
+                [x, moved.clamp(self.extent.0, self.extent.1), z]
+            })
+            .collect()
+    }
 }
 
-/// The bin of the axis, `bin` long from `lowest`, that `y` falls in (the last one for the
-/// highest particle).
-fn axial_bin(y: f64, lowest: f64, bin: f64, bins: usize) -> usize {
-    (((y - lowest) / bin).floor() as usize).min(bins - 1)
-}
-
-/// The end positions of one map with a fresh drift, for the period from `start` to `end`:
-/// each particle keeps its recorded end position but for its bin's drift, which becomes the
-/// drift of the bin a random offset further along the axis (the same offset for the whole
-/// bed, wrapped around its extent), so that the drift's pattern, and every particle's place
-/// among its neighbours, is the recording's. Positions stay within the bed's extent at the
-/// end.
-pub fn fresh_drift_ends(
-    start: &Snapshot,
-    end: &Snapshot,
-    bin: f64,
-    cell: f64,
-    rng: &mut Xoshiro256PlusPlus,
-) -> Vec<[f64; 3]> {
-    let (lowest, highest) = axial_extent(&end.pos);
-    let bins = (((highest - lowest) / bin).floor() as usize + 1).max(1);
-    let drift = axial_drift(start, end, bin, cell);
-    let offset = ((unit(rng) * bins as f64) as usize).min(bins - 1);
-    let key = |p: &[f64; 3]| ((p[0] / cell).floor() as i64, (p[2] / cell).floor() as i64);
-    end.pos
-        .iter()
-        .map(|&[x, y, z]| {
-            let cell_drift = &drift[&key(&[x, y, z])];
-            let b = axial_bin(y, lowest, bin, bins);
-            let moved = y + cell_drift[(b + offset) % bins] - cell_drift[b];
-            [x, moved.clamp(lowest, highest), z]
-        })
-        .collect()
+/// The square of the cross-section, `cell` wide, that `p` falls in.
+fn cell_key(p: &[f64; 3], cell: f64) -> (i64, i64) {
+    ((p[0] / cell).floor() as i64, (p[2] / cell).floor() as i64)
 }
 
 /// The particles ending in each `cell`-wide square of the cross-section (`x`, `z`), in
@@ -199,8 +215,7 @@ pub fn fresh_drift_ends(
 fn cross_section_cells(pos: &[[f64; 3]], cell: f64) -> BTreeMap<(i64, i64), Vec<usize>> {
     let mut cells: BTreeMap<(i64, i64), Vec<usize>> = BTreeMap::new();
     for (a, p) in pos.iter().enumerate() {
-        let key = ((p[0] / cell).floor() as i64, (p[2] / cell).floor() as i64);
-        cells.entry(key).or_default().push(a);
+        cells.entry(cell_key(p, cell)).or_default().push(a);
     }
     cells
 }
@@ -233,24 +248,41 @@ pub fn fresh_pool(
     seed: u64,
 ) -> Result<Option<Pool>, ExtrapolateError> {
     let d = start.mean_diameter();
-    let pool = match maps {
+    // what the pool's maps share, found once: the cells whose steps are redrawn, or the drift
+    enum Redraw {
+        Steps(BTreeMap<(i64, i64), Vec<usize>>),
+        Drift(AxialDrift),
+    }
+    let (pool, redraw) = match maps {
         BoundaryMaps::Exact => return Ok(None),
-        BoundaryMaps::FreshSteps { pool, .. } | BoundaryMaps::FreshDrift { pool, .. } => pool,
+        BoundaryMaps::FreshSteps {
+            pool,
+            cell_diameters,
+        } => (
+            pool,
+            Redraw::Steps(cross_section_cells(&end.pos, cell_diameters * d)),
+        ),
+        BoundaryMaps::FreshDrift {
+            pool,
+            bin_diameters,
+            cell_diameters,
+        } => (
+            pool,
+            Redraw::Drift(AxialDrift::of(
+                before,
+                end,
+                bin_diameters * d,
+                cell_diameters * d,
+            )),
+        ),
     };
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
     let mut pairings = Vec::with_capacity(pool as usize);
     let mut means = Vec::with_capacity(pool as usize);
     for _ in 0..pool {
-        let ends = match maps {
-            BoundaryMaps::Exact => unreachable!("no pool for the exact boundary"),
-            BoundaryMaps::FreshSteps { cell_diameters, .. } => {
-                fresh_step_ends(before, end, cell_diameters * d, &mut rng)
-            }
-            BoundaryMaps::FreshDrift {
-                bin_diameters,
-                cell_diameters,
-                ..
-            } => fresh_drift_ends(before, end, bin_diameters * d, cell_diameters * d, &mut rng),
+        let ends = match &redraw {
+            Redraw::Steps(cells) => step_ends(before, end, cells, &mut rng),
+            Redraw::Drift(drift) => drift.moved_ends(end, &mut rng),
         };
         let opts = PairingOptions::for_bed(d, &start.pos, &ends);
         let p = pairing::pair(&start.pos, &ends, &opts)?;
@@ -474,7 +506,7 @@ mod tests {
         let start = snapshot(0, at([-1.0, 0.5, 3.0, 5.0]));
         let end = snapshot(1, at([0.0, 1.5, 2.5, 5.0]));
         // steps 1, 1, −0.5, 0 (mean 0.375); ends in bins 0, 0, 1, 2
-        let drift = axial_drift(&start, &end, 2.0, 3.0);
+        let drift = AxialDrift::of(&start, &end, 2.0, 3.0).by_cell;
         assert_eq!(drift.len(), 1);
         let bins = &drift[&(0, 0)];
         let expected = [1.0 - 0.375, -0.5 - 0.375, 0.0 - 0.375];
@@ -503,18 +535,19 @@ mod tests {
         }
         let end = snapshot(1, end_pos);
         let (bin, cell) = (2.0, 4.0);
-        let drift = axial_drift(&start, &end, bin, cell);
+        let recorded = AxialDrift::of(&start, &end, bin, cell);
+        let drift = &recorded.by_cell;
         let spread = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
         let mut offsets_seen = std::collections::BTreeSet::new();
         for _ in 0..6 {
-            let ends = fresh_drift_ends(&start, &end, bin, cell, &mut rng);
+            let ends = recorded.moved_ends(&end, &mut rng);
             let (lowest, highest) = axial_extent(&end.pos);
             let bins = ((highest - lowest) / bin).floor() as usize + 1;
             let mut moved_by: BTreeMap<((i64, i64), usize), f64> = BTreeMap::new();
             for (a, e) in end.pos.iter().enumerate() {
                 assert_eq!([ends[a][0], ends[a][2]], [e[0], e[2]]);
-                let key = ((e[0] / cell).floor() as i64, (e[2] / cell).floor() as i64);
-                let b = axial_bin(e[1], lowest, bin, bins);
+                let key = cell_key(e, cell);
+                let b = (((e[1] - lowest) / bin).floor() as usize).min(bins - 1);
                 let by = ends[a][1] - e[1];
                 let unclamped = (lowest..=highest).contains(&(e[1] + by))
                     && ends[a][1] > lowest
