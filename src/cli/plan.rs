@@ -475,41 +475,44 @@ fn default_maps(kind: BoundaryKind) -> BoundaryMaps {
 /// `--boundary` with `--boundary-pool`, `--boundary-cell` and `--boundary-bin`, which only
 /// the fresh maps take (and the bin only the drift).
 fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
-    use extrapolate::boundary::{DEFAULT_BIN_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL};
-    let pool = args.boundary_pool.unwrap_or(DEFAULT_POOL);
-    let cell_diameters = args.boundary_cell.unwrap_or(DEFAULT_CELL_DIAMETERS);
-    Ok(match args.boundary {
-        BoundaryKind::Exact => {
+    let refused = |message: &str| Err(usage(message.into()));
+    Ok(match default_maps(args.boundary) {
+        BoundaryMaps::Exact => {
             if args.boundary_pool.is_some()
                 || args.boundary_cell.is_some()
                 || args.boundary_bin.is_some()
             {
-                return Err(usage(
+                return refused(
                     "--boundary-pool, --boundary-cell and --boundary-bin set the fresh \
                      boundary maps; with --boundary exact there is one pairing per start (add \
-                     --boundary fresh-steps or fresh-drift)"
-                        .into(),
-                ));
+                     --boundary fresh-steps or fresh-drift)",
+                );
             }
             BoundaryMaps::Exact
         }
-        BoundaryKind::FreshSteps => {
+        BoundaryMaps::FreshSteps {
+            pool,
+            cell_diameters,
+        } => {
             if args.boundary_bin.is_some() {
-                return Err(usage(
+                return refused(
                     "--boundary-bin sets the bins of --boundary fresh-drift; fresh-steps \
-                     redraws each particle's step and has no bins"
-                        .into(),
-                ));
+                     redraws each particle's step and has no bins",
+                );
             }
             BoundaryMaps::FreshSteps {
-                pool,
-                cell_diameters,
+                pool: args.boundary_pool.unwrap_or(pool),
+                cell_diameters: args.boundary_cell.unwrap_or(cell_diameters),
             }
         }
-        BoundaryKind::FreshDrift => BoundaryMaps::FreshDrift {
+        BoundaryMaps::FreshDrift {
             pool,
-            bin_diameters: args.boundary_bin.unwrap_or(DEFAULT_BIN_DIAMETERS),
+            bin_diameters,
             cell_diameters,
+        } => BoundaryMaps::FreshDrift {
+            pool: args.boundary_pool.unwrap_or(pool),
+            bin_diameters: args.boundary_bin.unwrap_or(bin_diameters),
+            cell_diameters: args.boundary_cell.unwrap_or(cell_diameters),
         },
     })
 }

@@ -299,10 +299,10 @@ fn run_one(
         Symmetry::None => "",
         Symmetry::AxialMirror => "_mirror",
     };
-    let boundary = match maps {
-        BoundaryMaps::Exact => "",
-        BoundaryMaps::FreshSteps { .. } => "_fresh-steps",
-        BoundaryMaps::FreshDrift { .. } => "_fresh-drift",
+    // `_fresh-steps`: the flag's own spelling
+    let boundary = match boundary_name(maps) {
+        "exact" => String::new(),
+        name => format!("_{}", name.replace('_', "-")),
     };
     let suffix = draw.map_or(String::new(), |d| format!("_{d}"));
     let extra = plan
