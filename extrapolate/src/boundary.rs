@@ -31,14 +31,14 @@ use tdex_format::Snapshot;
 
 pub use tdex_format::extrapolation::Boundary;
 
-/// Pairings per start in a pool: 8 and 128 give the same medians as 32 within 0.01 on eight
-/// beds of `heated_drum` over 100 periods.
+/// Pairings per start in a pool: 8 and 128 give the same mean median as 32 within 0.01 on
+/// eight beds of `heated_drum` over 100 periods (docs/validation.md#fresh-boundary-maps).
 pub const DEFAULT_POOL: u32 = 32;
-/// Width of the cross-section cells, in particle diameters: cells of 2 to 100 diameters
-/// move the redrawn steps' median by at most 0.03 on the same beds.
+/// Width of the cross-section cells, in particle diameters: cells of 2 and 100 diameters
+/// move the redrawn steps' mean median by at most 0.04 on the same beds.
 pub const DEFAULT_CELL_DIAMETERS: f64 = 3.0;
-/// Length of the axial bins of the drift, in particle diameters: bins of 2 and 4 diameters
-/// (over the whole cross-section) gave 1.01 and 1.03 on two beds of `axial_drum`.
+/// Length of the axial bins of the drift, in particle diameters: bins of 1 and 4 diameters
+/// move the mean median by at most 0.02 on eight beds of `axial_drum` over 100 periods.
 pub const DEFAULT_BIN_DIAMETERS: f64 = 2.0;
 
 /// The boundary maps an extrapolation asks for; the seed is the recurrence path's (the
