@@ -169,30 +169,7 @@ impl Verdict {
         // group means (bed mean for a bed without groups): the extrapolation's error and the
         // DEM runs' own spread
         let groups = contrast == ContrastKind::HotCold;
-        let mut error: Option<f64> = None;
-        let mut spread: Option<f64> = None;
-        for p in &periods {
-            let pairs: Vec<(f64, f64, &Vec<f64>)> = if groups {
-                [
-                    (p.hot_mean_extra, p.hot_mean_dem, &p.dem_runs_hot_mean),
-                    (p.cold_mean_extra, p.cold_mean_dem, &p.dem_runs_cold_mean),
-                ]
-                .into_iter()
-                .filter_map(|(e, d, runs)| Some((e?, d?, runs)))
-                .collect()
-            } else {
-                vec![(p.bed_mean_extra, p.bed_mean_dem, &p.dem_runs_bed_mean)]
-            };
-            for (extra, dem, runs) in pairs {
-                error = Some(error.unwrap_or(0.0).max((extra - dem).abs()));
-                if !runs.is_empty() {
-                    let all = runs.iter().copied().chain([dem]);
-                    let hi = all.clone().fold(f64::NEG_INFINITY, f64::max);
-                    let lo = all.fold(f64::INFINITY, f64::min);
-                    spread = Some(spread.unwrap_or(0.0).max(hi - lo));
-                }
-            }
-        }
+        let (error, spread) = means_error_and_spread(&periods, groups);
         let median_ratio = median(&ratios);
         let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs);
         let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
@@ -202,39 +179,13 @@ impl Verdict {
         };
         // the yardstick beside the median: how the DEM runs themselves score on it, and how
         // often each is beyond the others' range
-        let yardstick = match (median_ratio, dem_runs_median_ratio.as_slice()) {
-            (Some(m), runs) if !runs.is_empty() => {
-                let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                let above = runs.iter().filter(|&&r| r > m).count();
-                let n = compared.len();
-                let counts: Vec<usize> = dem_runs_outside_share
-                    .iter()
-                    .map(|share| (share * n as f64).round() as usize)
-                    .collect();
-                let beyond = match (counts.iter().min(), counts.iter().max()) {
-                    (Some(lo), Some(hi)) => format!(
-                        "; farther from the others than their farthest two at {} of the {n} \
-                         compared t_k (the extrapolation: {})",
-                        if lo == hi {
-                            lo.to_string()
-                        } else {
-                            format!("{lo}–{hi}")
-                        },
-                        outside_range.len()
-                    ),
-                    _ => String::new(),
-                };
-                format!(
-                    "; each DEM run judged the same way against the others: medians {}–{}, {above} of the \
-                     {} above the extrapolation's{beyond}",
-                    num(lo),
-                    num(hi),
-                    runs.len()
-                )
-            }
-            _ => String::new(),
-        };
+        let yardstick = yardstick_words(
+            median_ratio,
+            &dem_runs_median_ratio,
+            &dem_runs_outside_share,
+            compared.len(),
+            outside_range.len(),
+        );
         let one_pair = dem_runs == 2;
         let passes = median_ratio.map(|m| m <= 1.0 && (one_pair || outside_range.is_empty()));
         let what = if groups { "group means" } else { "bed mean" };
@@ -440,6 +391,85 @@ fn runs_outside_shares(
             outside as f64 / at.len() as f64
         })
         .collect()
+}
+
+/// The largest error of the group means (the bed mean for a bed without groups) against the
+/// DEM's over `periods`, and the largest spread of the DEM runs' own (`None` without runs).
+fn means_error_and_spread(
+    periods: &[&PeriodComparison],
+    groups: bool,
+) -> (Option<f64>, Option<f64>) {
+    let mut error: Option<f64> = None;
+    let mut spread: Option<f64> = None;
+    for p in periods {
+        let pairs: Vec<(f64, f64, &Vec<f64>)> = if groups {
+            [
+                (p.hot_mean_extra, p.hot_mean_dem, &p.dem_runs_hot_mean),
+                (p.cold_mean_extra, p.cold_mean_dem, &p.dem_runs_cold_mean),
+            ]
+            .into_iter()
+            .filter_map(|(e, d, runs)| Some((e?, d?, runs)))
+            .collect()
+        } else {
+            vec![(p.bed_mean_extra, p.bed_mean_dem, &p.dem_runs_bed_mean)]
+        };
+        for (extra, dem, runs) in pairs {
+            error = Some(error.unwrap_or(0.0).max((extra - dem).abs()));
+            if !runs.is_empty() {
+                let all = runs.iter().copied().chain([dem]);
+                let hi = all.clone().fold(f64::NEG_INFINITY, f64::max);
+                let lo = all.fold(f64::INFINITY, f64::min);
+                spread = Some(spread.unwrap_or(0.0).max(hi - lo));
+            }
+        }
+    }
+    (error, spread)
+}
+
+/// The yardstick beside the median: how the DEM runs score judged the same way against the
+/// others (`runs_medians`), how many lie above the extrapolation's median, and how often each
+/// is beyond the others' range (`outside_shares` of the `compared` t_k) beside the
+/// extrapolation's `outside` count; empty without a median or without such runs.
+fn yardstick_words(
+    median_ratio: Option<f64>,
+    runs_medians: &[f64],
+    outside_shares: &[f64],
+    compared: usize,
+    outside: usize,
+) -> String {
+    match (median_ratio, runs_medians) {
+        (Some(m), runs) if !runs.is_empty() => {
+            let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let above = runs.iter().filter(|&&r| r > m).count();
+            let n = compared;
+            let counts: Vec<usize> = outside_shares
+                .iter()
+                .map(|share| (share * n as f64).round() as usize)
+                .collect();
+            let beyond = match (counts.iter().min(), counts.iter().max()) {
+                (Some(lo), Some(hi)) => format!(
+                    "; farther from the others than their farthest two at {} of the {n} \
+                     compared t_k (the extrapolation: {})",
+                    if lo == hi {
+                        lo.to_string()
+                    } else {
+                        format!("{lo}–{hi}")
+                    },
+                    outside
+                ),
+                _ => String::new(),
+            };
+            format!(
+                "; each DEM run judged the same way against the others: medians {}–{}, {above} of the \
+                 {} above the extrapolation's{beyond}",
+                num(lo),
+                num(hi),
+                runs.len()
+            )
+        }
+        _ => String::new(),
+    }
 }
 
 #[cfg(test)]
