@@ -184,3 +184,62 @@ fn a_drum_too_wide_for_its_neighbour_grid_is_refused_before_any_work() {
         &["drum.radius", "neighbour grid", "at most 3e7"],
     );
 }
+
+/// The tiny case with three size classes (radii in m, number fractions) instead of its
+/// one radius.
+fn with_classes(classes: &str) -> String {
+    edit(
+        "radius = 0.005",
+        &format!("classes = [{classes}]\nfractions = \"number\""),
+    )
+}
+
+#[test]
+fn size_classes_whose_fractions_do_not_sum_to_one_are_refused_with_their_sum() {
+    assert_refused(
+        &with_classes(
+            "{ radius = 0.003, fraction = 0.3 }, { radius = 0.004, fraction = 0.3 }, { radius = 0.005, fraction = 0.3 }",
+        ),
+        &["particles.classes", "fractions summing to 0.9", "must sum to 1"],
+    );
+}
+
+#[test]
+fn a_size_class_too_large_for_the_drum_is_refused_by_its_index() {
+    // the drum is 0.05 m in radius: a 0.03 m sphere is 0.06 m across
+    assert_refused(
+        &with_classes("{ radius = 0.003, fraction = 0.5 }, { radius = 0.03, fraction = 0.5 }"),
+        &[
+            "particles.classes[1].radius = 0.03",
+            "drum's radius (0.05 m)",
+        ],
+    );
+}
+
+#[test]
+fn a_time_step_over_the_smallest_class_limit_is_refused() {
+    // dt = 1e-4 s suits 5 mm spheres, not 1 mm ones (Rayleigh time 8.6e-5 s)
+    assert_refused(
+        &with_classes("{ radius = 0.001, fraction = 0.5 }, { radius = 0.005, fraction = 0.5 }"),
+        &[
+            "time.dt = 0.0001",
+            "smallest spheres (radius 0.001 m)",
+            "Rayleigh time",
+        ],
+    );
+}
+
+#[test]
+fn sizes_given_twice_or_not_at_all_are_refused() {
+    assert_refused(
+        &edit(
+            "radius = 0.005",
+            "radius = 0.005\nclasses = [{ radius = 0.004, fraction = 1.0 }]",
+        ),
+        &["particles", "radius and classes", "exactly one way"],
+    );
+    assert_refused(
+        &edit("radius = 0.005", "fractions = \"mass\""),
+        &["particles", "(no size)"],
+    );
+}

@@ -48,16 +48,23 @@ fn elastic_duration(law: &PairLaw, r_eff: f64, m_eff: f64, v0: f64) -> f64 {
 
 /// Two equal spheres approaching head-on at relative speed `v0`: (duration, restitution, theory).
 fn collide(restitution: f64, v0: f64) -> (f64, f64, f64) {
+    let (duration, e, theory, _) = collide_spheres(restitution, v0, RADIUS, RADIUS);
+    (duration, e, theory)
+}
+
+/// Spheres of radii `ri`, `rj` approaching head-on at relative speed `v0`, their centre of
+/// mass at rest: (duration, restitution, theory with R* and m*, total momentum after).
+fn collide_spheres(restitution: f64, v0: f64, ri: f64, rj: f64) -> (f64, f64, f64, f64) {
     let mut p = ParticleSet::default();
-    p.push(0, [-RADIUS - 1e-4, 0.0, 0.0], RADIUS, DENSITY, 300.0);
-    p.push(1, [RADIUS + 1e-4, 0.0, 0.0], RADIUS, DENSITY, 300.0);
-    p.vel[0] = [0.5 * v0, 0.0, 0.0];
-    p.vel[1] = [-0.5 * v0, 0.0, 0.0];
-    let mass = p.mass[0];
+    p.push(0, [-ri - 1e-4, 0.0, 0.0], ri, DENSITY, 300.0);
+    p.push(1, [rj + 1e-4, 0.0, 0.0], rj, DENSITY, 300.0);
+    let (mi, mj) = (p.mass[0], p.mass[1]);
+    p.vel[0] = [v0 * mj / (mi + mj), 0.0, 0.0];
+    p.vel[1] = [-v0 * mi / (mi + mj), 0.0, 0.0];
     let law_probe = World::new(p.clone(), no_walls(), restitution, 1.0, 0.0)
         .params
         .particle_particle;
-    let theory = theory_duration(&law_probe, 0.5 * RADIUS, 0.5 * mass, v0);
+    let theory = theory_duration(&law_probe, ri * rj / (ri + rj), mi * mj / (mi + mj), v0);
     let dt = theory / 2000.0;
     let mut world = World::new(p, no_walls(), restitution, dt, 0.0);
     let (mut first, mut last) = (None, 0u64);
@@ -75,7 +82,30 @@ fn collide(restitution: f64, v0: f64) -> (f64, f64, f64) {
     let slot0 = world.particles.id.iter().position(|&id| id == 0).unwrap();
     let slot1 = 1 - slot0;
     let v_rel_after = world.particles.vel[slot1][0] - world.particles.vel[slot0][0];
-    (duration, v_rel_after / v0, theory)
+    let momentum = world.particles.mass[slot0] * world.particles.vel[slot0][0]
+        + world.particles.mass[slot1] * world.particles.vel[slot1][0];
+    (duration, v_rel_after / v0, theory, momentum)
+}
+
+#[test]
+fn unequal_spheres_collide_as_hertz_with_the_effective_radius_and_mass() {
+    // a sphere of 5 mm against one of 2.5 mm (an eighth of its mass)
+    for e in [0.2, 0.9] {
+        let (duration, e_measured, theory, momentum) =
+            collide_spheres(e, 0.5, RADIUS, 0.5 * RADIUS);
+        eprintln!(
+            "unequal, e = {e}: duration {duration:.5e} s, theory {theory:.5e} s ({:+.3} %), restitution {e_measured:.5}",
+            100.0 * (duration / theory - 1.0)
+        );
+        assert!(
+            (duration - theory).abs() / theory < 0.02,
+            "e = {e}: duration {duration:.6e} s vs theory {theory:.6e} s"
+        );
+        assert!((e_measured - e).abs() / e < 0.02, "e = {e}: {e_measured}");
+        // momentum started at zero: what one sphere gains the other loses
+        let scale = DENSITY * 4.0 / 3.0 * std::f64::consts::PI * RADIUS.powi(3) * 0.5;
+        assert!(momentum.abs() < 1e-12 * scale, "momentum {momentum:e}");
+    }
 }
 
 #[test]

@@ -22,7 +22,7 @@ const SKIN_PER_DIAMETER: f64 = 0.4;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SimulationError {
-    #[error("cannot insert {count} particles: the insertion lattice of the drum holds fewer")]
+    #[error("cannot insert {count} particles: the drum has no room for them without overlaps")]
     Insertion { count: usize },
     #[error("the simulation became unstable at step {step} (t = {time:.6} s): particle {id} is at {pos:?}, outside the drum; reduce time.dt")]
     Unstable {
@@ -81,9 +81,9 @@ impl Simulation {
         let p = &case.particles;
         let m = &case.material;
         let start_temp = case.temperature.before_t0();
+        let sizes = p.size_classes();
         let particles = insertion::insert(
-            p.count,
-            p.radius,
+            &sizes,
             m.density,
             start_temp,
             case.drum.radius,
@@ -120,8 +120,9 @@ impl Simulation {
             EndCaps::Fixed => WallMotion::Fixed,
         };
         let walls = WallSet::drum(case.drum.radius, case.drum.length, end_caps);
-        let skin = SKIN_PER_DIAMETER * 2.0 * p.radius;
-        let cell = 2.0 * p.radius + skin;
+        // the largest spheres set the cells: a pair of them must be found within one
+        let skin = SKIN_PER_DIAMETER * 2.0 * sizes.largest();
+        let cell = 2.0 * sizes.largest() + skin;
         let (rd, half) = (case.drum.radius + cell, 0.5 * case.drum.length + cell);
         let grid = CellGrid::new([-rd, -half, -rd], [rd, half, rd], cell);
         Ok(Self {

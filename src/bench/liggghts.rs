@@ -4,7 +4,7 @@
 
 use crate::cli::BenchPlan;
 use anyhow::{bail, Context, Result};
-use recorder::case::{Case, ContactArea, EndCaps, RollingModel, TemperatureSpec};
+use recorder::case::{Case, ContactArea, EndCaps, ParticleSize, RollingModel, TemperatureSpec};
 use recorder::particles::ParticleSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -167,7 +167,10 @@ fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> 
     if case.drum.wall_temperature.is_some() {
         bail!("--vs-liggghts: the deck has no heated wall (the case sets drum.wall_temperature)");
     }
-    let (r, l, rp) = (case.drum.radius, case.drum.length, case.particles.radius);
+    let ParticleSize::Single { radius: rp } = case.particles.size else {
+        bail!("--vs-liggghts: the deck inserts spheres of one size (the case gives several)");
+    };
+    let (r, l) = (case.drum.radius, case.drum.length);
     let (meshes, mesh_fixes, n_meshes, names, rotating) = match case.drum.end_caps {
         EndCaps::Rotating => (
             vec![("drum.stl", true, true)],

@@ -1,9 +1,11 @@
 //! Case files: the TOML schema, loading with errors that name the file and field, and validation.
 
 mod schema;
+mod sizes;
 mod validate;
 
 pub use schema::*;
+pub use sizes::{SizeClasses, FRACTION_SUM_TOLERANCE, MAX_SIZE_CLASSES};
 pub use validate::{rayleigh_time, validate, MAX_FILL_FRACTION, MAX_RAYLEIGH_FRACTION};
 
 use std::path::{Path, PathBuf};

@@ -22,13 +22,192 @@ pub struct Case {
     pub temperature: TemperatureSpec,
 }
 
+/// The spheres: how many, and their sizes.
+///
+/// Read and written through `ParticleFields`, the `[particles]` table as the file spells
+/// it: one of `radius`, `classes` or `distribution`, so a one-size case keeps its two keys
+/// in a recording's resolved case.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "ParticleFields", into = "ParticleFields")]
 pub struct ParticlesSpec {
     /// Number of spheres.
     pub count: usize,
-    /// Sphere radius (m); monodisperse for now.
+    pub size: ParticleSize,
+}
+
+/// The sizes of the spheres.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParticleSize {
+    /// Every sphere of this radius (m).
+    Single { radius: f64 },
+    /// Spheres of a few radii in given fractions (LIGGGHTS `particletemplate/sphere` with
+    /// `particledistribution/discrete`).
+    Classes {
+        classes: Vec<SizeClass>,
+        fractions: FractionBasis,
+    },
+    /// A truncated normal or log-normal distribution of the radius, cut into classes of
+    /// equal width.
+    Distribution {
+        distribution: Distribution,
+        fractions: FractionBasis,
+    },
+}
+
+/// One radius of a discrete size distribution and its share of the bed.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SizeClass {
+    /// m
     pub radius: f64,
+    /// Share of the particles (by number or by mass, see [`FractionBasis`]), in (0, 1].
+    pub fraction: f64,
+}
+
+/// Whether the fractions of a size distribution count particles or weigh them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FractionBasis {
+    /// Shares of the particle count (EDEM's number distribution).
+    #[default]
+    Number,
+    /// Shares of the bed's mass (LIGGGHTS `particledistribution/discrete`).
+    Mass,
+}
+
+/// A continuous distribution of the radius, truncated to `[min_radius, max_radius]` and
+/// discretised into `classes` bins of equal width: each bin's particles take the bin's
+/// middle radius, and its share is the distribution's probability over the bin.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Distribution {
+    pub shape: DistributionShape,
+    /// Mean of the untruncated distribution of the radius (m).
+    pub mean_radius: f64,
+    /// Standard deviation of the untruncated distribution of the radius (m).
+    pub std_radius: f64,
+    /// m
+    pub min_radius: f64,
+    /// m
+    pub max_radius: f64,
+    /// Number of classes (bins) the range is cut into.
+    pub classes: u32,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DistributionShape {
+    Normal,
+    /// ln(radius) normal, with the radius's mean and standard deviation as given.
+    Lognormal,
+}
+
+/// The `[particles]` table as written: every key of every way to give the sizes, checked
+/// when it becomes a [`ParticlesSpec`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ParticleFields {
+    count: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    radius: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    classes: Option<Vec<SizeClass>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    distribution: Option<Distribution>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    fractions: Option<FractionBasis>,
+}
+
+impl TryFrom<ParticleFields> for ParticlesSpec {
+    type Error = Violation;
+
+    /// Refuses a table that gives the sizes in none or several ways, or `fractions` with a
+    /// single radius.
+    fn try_from(fields: ParticleFields) -> Result<Self, Violation> {
+        let ParticleFields {
+            count,
+            radius,
+            classes,
+            distribution,
+            fractions,
+        } = fields;
+        let given = [
+            radius.map(|_| "radius"),
+            classes.as_ref().map(|_| "classes"),
+            distribution.map(|_| "distribution"),
+        ];
+        let given: Vec<&str> = given.into_iter().flatten().collect();
+        let size = match (radius, classes, distribution) {
+            (Some(radius), None, None) => {
+                if let Some(f) = fractions {
+                    return Err(refuse(
+                        "particles.fractions",
+                        format!("\"{}\"", f.name()),
+                        "only allowed with particles.classes or particles.distribution",
+                    ));
+                }
+                ParticleSize::Single { radius }
+            }
+            (None, Some(classes), None) => ParticleSize::Classes {
+                classes,
+                fractions: fractions.unwrap_or_default(),
+            },
+            (None, None, Some(distribution)) => ParticleSize::Distribution {
+                distribution,
+                fractions: fractions.unwrap_or_default(),
+            },
+            _ => {
+                return Err(refuse(
+                    "particles",
+                    if given.is_empty() {
+                        "(no size)".to_string()
+                    } else {
+                        given.join(" and ")
+                    },
+                    "give the sizes in exactly one way: radius (one size), classes (a \
+                     discrete distribution) or distribution (normal or lognormal)",
+                ))
+            }
+        };
+        Ok(ParticlesSpec { count, size })
+    }
+}
+
+impl From<ParticlesSpec> for ParticleFields {
+    fn from(spec: ParticlesSpec) -> Self {
+        let mut fields = ParticleFields {
+            count: spec.count,
+            radius: None,
+            classes: None,
+            distribution: None,
+            fractions: None,
+        };
+        match spec.size {
+            ParticleSize::Single { radius } => fields.radius = Some(radius),
+            ParticleSize::Classes { classes, fractions } => {
+                fields.classes = Some(classes);
+                fields.fractions = Some(fractions);
+            }
+            ParticleSize::Distribution {
+                distribution,
+                fractions,
+            } => {
+                fields.distribution = Some(distribution);
+                fields.fractions = Some(fractions);
+            }
+        }
+        fields
+    }
+}
+
+impl FractionBasis {
+    /// The spelling in a case file.
+    pub fn name(self) -> &'static str {
+        match self {
+            FractionBasis::Number => "number",
+            FractionBasis::Mass => "mass",
+        }
+    }
 }
 
 /// Bulk properties of the particle material (the drum wall shares the elastic ones).

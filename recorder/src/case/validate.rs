@@ -1,6 +1,7 @@
 //! Physical validation of a parsed case: every refusal names the field, the value and the limit.
 
 use super::schema::*;
+use super::sizes;
 use crate::insertion;
 
 /// The largest accepted `dt` as a fraction of the Rayleigh time (the paper runs at 23 %;
@@ -107,7 +108,7 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
             format!("must be at most {}", u32::MAX / 2),
         ));
     }
-    positive("particles.radius", p.radius)?;
+    let sizes = sizes::resolve(p)?;
 
     let m = &case.material;
     positive("material.density", m.density)?;
@@ -139,19 +140,42 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
     let d = &case.drum;
     positive("drum.radius", d.radius)?;
     positive("drum.length", d.length)?;
-    if d.radius <= 2.0 * p.radius {
-        return Err(refuse(
-            "drum.radius",
-            d.radius,
-            format!("must exceed the particle diameter {}", 2.0 * p.radius),
-        ));
-    }
-    if d.length <= 2.0 * p.radius {
-        return Err(refuse(
-            "drum.length",
-            d.length,
-            format!("must exceed the particle diameter {}", 2.0 * p.radius),
-        ));
+    match &p.size {
+        ParticleSize::Single { radius } => {
+            for (field, extent) in [("drum.radius", d.radius), ("drum.length", d.length)] {
+                if extent <= 2.0 * radius {
+                    return Err(refuse(
+                        field,
+                        extent,
+                        format!("must exceed the particle diameter {}", 2.0 * radius),
+                    ));
+                }
+            }
+        }
+        // the refusal names the class, the size the user can change
+        _ => {
+            let largest = sizes.largest();
+            if d.radius.min(d.length) <= 2.0 * largest {
+                let field = match &p.size {
+                    ParticleSize::Classes { classes, .. } => format!(
+                        "particles.classes[{}].radius",
+                        classes
+                            .iter()
+                            .position(|c| c.radius == largest)
+                            .unwrap_or(0)
+                    ),
+                    _ => "particles.distribution.max_radius".to_string(),
+                };
+                return Err(refuse(
+                    &field,
+                    largest,
+                    format!(
+                        "a sphere's diameter must be less than the drum's radius ({} m) and length ({} m)",
+                        d.radius, d.length
+                    ),
+                ));
+            }
+        }
     }
     positive("drum.rotation_period", d.rotation_period)?;
     if let Some(tw) = d.wall_temperature {
@@ -163,13 +187,20 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
 
     let t = &case.time;
     positive("time.dt", t.dt)?;
-    let t_rayleigh = rayleigh_time(p.radius, m.density, m.youngs_modulus, nu);
+    // the smallest spheres have the shortest contacts: they bound the step
+    let smallest = sizes.smallest();
+    let t_rayleigh = rayleigh_time(smallest, m.density, m.youngs_modulus, nu);
     if t.dt > MAX_RAYLEIGH_FRACTION * t_rayleigh {
+        let of = if sizes.radius.len() > 1 {
+            format!(" of the smallest spheres (radius {smallest} m),")
+        } else {
+            String::new()
+        };
         return Err(refuse(
             "time.dt",
             t.dt,
             format!(
-                "must be <= {:.0} % of the Rayleigh time {:.4e} s, i.e. <= {:.4e} s (dt is {:.1} % of it)",
+                "must be <= {:.0} % of the Rayleigh time{of} {:.4e} s, i.e. <= {:.4e} s (dt is {:.1} % of it)",
                 MAX_RAYLEIGH_FRACTION * 100.0,
                 t_rayleigh,
                 MAX_RAYLEIGH_FRACTION * t_rayleigh,
@@ -193,8 +224,7 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
     }
 
     // The settled bed must fit, and insertion must have room for every particle.
-    let particle_volume = 4.0 / 3.0 * std::f64::consts::PI * p.radius.powi(3);
-    let bed_volume = p.count as f64 * particle_volume / BED_PACKING;
+    let bed_volume = sizes.solid_volume() / BED_PACKING;
     let drum_volume = std::f64::consts::PI * d.radius * d.radius * d.length;
     if bed_volume > MAX_FILL_FRACTION * drum_volume {
         return Err(refuse(
@@ -212,19 +242,35 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
     // The neighbour grid spans the drum in cells of a diameter and a skin: a drum thousands
     // of radii wide would ask the run for a grid larger than the machine, so it is refused
     // here, before any work. Counted in cells of one diameter (an upper bound).
-    let cell = 2.0 * p.radius;
+    let largest = sizes.largest();
+    let cell = 2.0 * largest;
     let grid_cells = (2.0 * (d.radius / cell + 1.0)).powi(2) * (d.length / cell + 2.0);
     if grid_cells > MAX_GRID_CELLS {
         return Err(refuse(
             "drum.radius",
             d.radius,
             format!(
-                "with particles of radius {} m the neighbour grid would have {grid_cells:.2e} cells (drum {} m long); at most {MAX_GRID_CELLS:.0e} are allowed: use larger particles or a smaller drum",
-                p.radius, d.length
+                "with particles of radius {largest} m the neighbour grid would have {grid_cells:.2e} cells (drum {} m long); at most {MAX_GRID_CELLS:.0e} are allowed: use larger particles or a smaller drum",
+                d.length
             ),
         ));
     }
-    let sites = insertion::lattice_site_count(p.radius, d.radius, d.length, p.count);
+    if sizes.radius.len() > 1 {
+        let fill = insertion::random_fill(&sizes, d.radius, d.length);
+        if fill > insertion::MAX_RANDOM_FILL {
+            return Err(refuse(
+                "particles.count",
+                p.count,
+                format!(
+                    "the spheres take {:.0} % of the drum's volume; spheres of several sizes are inserted at random, which places at most {:.0} %: lower the count or lengthen the drum (the bed then settles)",
+                    100.0 * fill,
+                    100.0 * insertion::MAX_RANDOM_FILL
+                ),
+            ));
+        }
+        return Ok(());
+    }
+    let sites = insertion::lattice_site_count(largest, d.radius, d.length, p.count);
     if sites < p.count {
         return Err(refuse(
             "particles.count",

@@ -500,7 +500,7 @@ impl Checkpoint<'static> {
                         }
                     )));
                 }
-                let (t0_step, r) = (settle + spin, case.particles.radius);
+                let (t0_step, r) = (settle + spin, case.particles.largest_radius());
                 if out.run.step_t0 != t0_step
                     || out.run.t0 != t0_step as f64 * case.time.dt
                     || out.run.r_max != r
