@@ -243,3 +243,22 @@ fn sizes_given_twice_or_not_at_all_are_refused() {
         &["particles", "(no size)"],
     );
 }
+
+#[test]
+fn a_periodic_section_shorter_than_two_largest_diameters_is_refused() {
+    // spheres of 5 mm radius: the section must be at least 0.02 m long
+    let short = edit(
+        "rotation_period = 2.0",
+        "rotation_period = 2.0\nend_caps = \"periodic\"",
+    )
+    .replacen("length = 0.06", "length = 0.015", 1);
+    assert_refused(
+        &short,
+        &[
+            "drum.length = 0.015",
+            "periodic section",
+            "two of the largest particle diameters",
+            "0.02 m",
+        ],
+    );
+}

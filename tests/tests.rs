@@ -25,5 +25,6 @@ mod fuzz_corpus;
 mod golden_outputs;
 mod physics_collision;
 mod physics_conduction;
+mod physics_periodic;
 mod record;
 mod replay;

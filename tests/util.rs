@@ -6,6 +6,7 @@ use recorder::counters::Counters;
 use recorder::heat::ConductionLaw;
 use recorder::neighbor::{CellGrid, NeighborList};
 use recorder::particles::ParticleSet;
+use recorder::periodic::AxialPeriod;
 use recorder::pipeline::{ContactCount, Pipeline, StepParams};
 use recorder::wall::WallSet;
 use std::path::{Path, PathBuf};
@@ -53,6 +54,7 @@ impl World {
                 HEAT_CAPACITY,
                 YOUNG,
             ),
+            axial_period: None,
         };
         let rmax = particles.radius.iter().cloned().fold(0.0, f64::max);
         let skin = 0.4 * rmax;
@@ -66,6 +68,20 @@ impl World {
             pipeline: Pipeline::new(grid),
             counters: Counters::default(),
         }
+    }
+
+    /// This world as a section periodic along y, `length` long and centred on the origin
+    /// (its grid spans exactly one period along y).
+    pub fn periodic(mut self, length: f64) -> Self {
+        let cell = self.pipeline.grid.cell_size;
+        let half = 0.5 * length;
+        self.pipeline = Pipeline::new(CellGrid::periodic_along_y(
+            [-0.1, -half, -0.1],
+            [0.1, half, 0.1],
+            cell,
+        ));
+        self.params.axial_period = Some(AxialPeriod { length });
+        self
     }
 
     pub fn step(&mut self) -> ContactCount {

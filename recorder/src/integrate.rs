@@ -2,6 +2,7 @@
 
 use crate::math::*;
 use crate::particles::ParticleSet;
+use crate::periodic::{nearest_image, AxialPeriod};
 use rayon::prelude::*;
 
 /// Moment of inertia of a solid sphere is `INERTIA · m R²`.
@@ -9,7 +10,8 @@ const INERTIA: f64 = 0.4;
 /// Particles per parallel task: enough work to pay for the dispatch.
 const MIN_TASK: usize = 4096;
 
-/// First half kick and drift: `v += dt/2 (F/m + g)`, `x += dt v`, `ω += dt/2 T/I`. Returns
+/// First half kick and drift: `v += dt/2 (F/m + g)`, `x += dt v`, `ω += dt/2 T/I`; in a
+/// periodic drum a sphere that crossed an end face is moved to the other. Returns
 /// whether a particle now lies farther than `limit` from its place in `reference` (or the
 /// reference is missing): the Verlet list's rebuild test, done in the same pass.
 pub fn initial_integrate(
@@ -18,6 +20,7 @@ pub fn initial_integrate(
     gravity: Vec3,
     reference: &[Vec3],
     limit: f64,
+    period: Option<AxialPeriod>,
 ) -> bool {
     let half = 0.5 * dt;
     let n = p.len();
@@ -35,6 +38,9 @@ pub fn initial_integrate(
                 (f, t, r, m): (&Vec3, &Vec3, &f64, &f64)| {
         *v = add(*v, scale(add(scale(*f, 1.0 / m), gravity), half));
         *x = add(*x, scale(*v, dt));
+        if let Some(period) = period {
+            x[1] = period.wrap(x[1]);
+        }
         *w = add(*w, scale(*t, half / (INERTIA * m * r * r)));
     };
     let kicked = (pos, vel, omega).into_par_iter().zip((
@@ -54,7 +60,8 @@ pub fn initial_integrate(
         .map(|((a, b), x0)| {
             kick((&mut *a.0, a.1, a.2), b);
             // a NaN displacement also forces a rebuild (and the out-of-drum check then reports it)
-            let d2 = norm2(sub(*a.0, *x0));
+            // across the seam the displacement is the short way round
+            let d2 = norm2(nearest_image(sub(*a.0, *x0), period));
             d2.is_nan() || d2 > limit2
         })
         .reduce(|| false, |a, b| a || b)

@@ -21,6 +21,7 @@ pub mod integrate;
 pub mod math;
 pub mod neighbor;
 pub mod particles;
+pub mod periodic;
 pub mod pipeline;
 pub mod prefetch;
 pub mod record;

@@ -11,6 +11,7 @@ use crate::integrate;
 use crate::math::*;
 use crate::neighbor::{CellGrid, ListPieces, NeighborList};
 use crate::particles::ParticleSet;
+use crate::periodic::AxialPeriod;
 use crate::prefetch::{self, ArrayAddress, Prefetch};
 use crate::slices::{for_each_task, pieces_at, slices_indexed_alike};
 use crate::wall::WallSet;
@@ -35,6 +36,8 @@ pub struct StepParams {
     pub particle_particle: PairLaw,
     pub particle_wall: PairLaw,
     pub conduction: ConductionLaw,
+    /// The section's period along the axis when the drum is periodic (no end caps).
+    pub axial_period: Option<AxialPeriod>,
 }
 
 /// Contacts counted during the last step.
@@ -83,6 +86,7 @@ impl Pipeline {
                 params.gravity,
                 &neighbors.pos_at_build,
                 0.5 * neighbors.skin,
+                params.axial_period,
             )
         });
         timed(&mut counters.neighbor, || {
@@ -186,6 +190,7 @@ pub fn contact_interactions_in_chunks(
         dt: params.dt,
         uniform_pair: *uniform_pair,
     };
+    let axial_period = params.axial_period;
     let wall_contacts = WallContacts {
         walls,
         law: &params.particle_wall,
@@ -284,8 +289,15 @@ pub fn contact_interactions_in_chunks(
                 holder.scatter(batch, &mut sums, first_slot);
                 next.advance(holder.slots_done(first_slot) as f64 / holders);
             };
-            let touching_pairs =
-                narrow_phase::scan(&entries, pos, radius, touch, &mut batch, &mut evaluate);
+            let touching_pairs = narrow_phase::scan(
+                &entries,
+                pos,
+                radius,
+                axial_period,
+                touch,
+                &mut batch,
+                &mut evaluate,
+            );
             // the batch holds fewer than a full batch's contacts now: one evaluation
             evaluate(&mut batch);
             holder.add_to(&mut sums, first_slot);

@@ -1,7 +1,7 @@
 //! A drum case brought to life: insertion, settling, spin-up, temperatures at `t0`, heating.
 //! Owns the sets and the pipeline, and reports heat totals and group means.
 
-use crate::case::{Case, EndCaps, TemperatureSpec};
+use crate::case::{Case, TemperatureSpec};
 use crate::contact::PairLaw;
 use crate::counters::Counters;
 use crate::heat::ConductionLaw;
@@ -9,8 +9,9 @@ use crate::insertion;
 use crate::math::{norm2, sub};
 use crate::neighbor::{CellGrid, NeighborList};
 use crate::particles::ParticleSet;
+use crate::periodic::nearest_image;
 use crate::pipeline::{ContactCount, Pipeline, StepParams};
-use crate::wall::{WallMotion, WallSet};
+use crate::wall::WallSet;
 use tdex_format::Snapshot;
 
 /// Standard gravity along −z (m/s²).
@@ -114,17 +115,24 @@ impl Simulation {
                 m.heat_capacity,
                 m.youngs_modulus,
             ),
+            axial_period: case.drum.axial_period(),
         };
-        let end_caps = match case.drum.end_caps {
-            EndCaps::Rotating => WallMotion::Rotating,
-            EndCaps::Fixed => WallMotion::Fixed,
-        };
-        let walls = WallSet::drum(case.drum.radius, case.drum.length, end_caps);
+        let walls = WallSet::of_drum(&case.drum);
         // the largest spheres set the cells: a pair of them must be found within one
         let skin = SKIN_PER_DIAMETER * 2.0 * sizes.largest();
         let cell = 2.0 * sizes.largest() + skin;
-        let (rd, half) = (case.drum.radius + cell, 0.5 * case.drum.length + cell);
-        let grid = CellGrid::new([-rd, -half, -rd], [rd, half, rd], cell);
+        let rd = case.drum.radius + cell;
+        let grid = match case.drum.axial_period() {
+            // the grid spans exactly one period along the axis, the positions' range
+            Some(period) => {
+                let half = 0.5 * period.length;
+                CellGrid::periodic_along_y([-rd, -half, -rd], [rd, half, rd], cell)
+            }
+            None => {
+                let half = 0.5 * case.drum.length + cell;
+                CellGrid::new([-rd, -half, -rd], [rd, half, rd], cell)
+            }
+        };
         Ok(Self {
             case: case.clone(),
             params,
@@ -286,7 +294,8 @@ impl Simulation {
         (0..p.len()).flat_map(move |i| {
             list.range(i).filter(|&e| list.touching[e]).map(move |e| {
                 let j = list.neighbors[e] as usize;
-                let r = norm2(sub(p.pos[i], p.pos[j])).sqrt();
+                let delta = nearest_image(sub(p.pos[i], p.pos[j]), self.params.axial_period);
+                let r = norm2(delta).sqrt();
                 let sqrt_area = heat.pair_area(r, p.radius[i], p.radius[j]).sqrt();
                 let (a, b) = (p.id[i].min(p.id[j]), p.id[i].max(p.id[j]));
                 (a, b, sqrt_area)

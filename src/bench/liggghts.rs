@@ -189,6 +189,7 @@ fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> 
             "mantle caps",
             "mantle",
         ),
+        EndCaps::Periodic => bail!("--vs-liggghts: the deck closes the drum with end caps (the case sets drum.end_caps = \"periodic\")"),
     };
     for (file, mantle, caps) in meshes {
         let path = dir.join(file);

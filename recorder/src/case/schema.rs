@@ -302,7 +302,8 @@ pub struct Drum {
     pub length: f64,
     /// Seconds per revolution, counter-clockwise seen from +y (z → x).
     pub rotation_period: f64,
-    /// Whether the flat end caps turn with the mantle or stand still.
+    /// Whether the flat end caps turn with the mantle or stand still, or the drum has none
+    /// and is periodic along its axis.
     #[serde(default)]
     pub end_caps: EndCaps,
     /// When set, the mantle is held at this temperature (K) from `t0` on and conducts
@@ -322,6 +323,10 @@ pub enum EndCaps {
     Rotating,
     /// The caps are fixed (a kiln's stationary hoods).
     Fixed,
+    /// No caps: the drum is a section of a longer kiln, periodic along its axis (LIGGGHTS
+    /// `boundary f p f`). A sphere leaving one end face enters through the other, and
+    /// spheres touch across the seam.
+    Periodic,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -484,5 +489,14 @@ impl Axis {
             Axis::Y => 1,
             Axis::Z => 2,
         }
+    }
+}
+
+impl Drum {
+    /// The section's period along the axis, when the drum is periodic.
+    pub fn axial_period(&self) -> Option<crate::periodic::AxialPeriod> {
+        (self.end_caps == EndCaps::Periodic).then_some(crate::periodic::AxialPeriod {
+            length: self.length,
+        })
     }
 }

@@ -177,6 +177,18 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
             }
         }
     }
+    if d.end_caps == EndCaps::Periodic && d.length < 4.0 * sizes.largest() {
+        // shorter, a sphere could touch two images of another across the seam
+        return Err(refuse(
+            "drum.length",
+            d.length,
+            format!(
+                "a periodic section must be at least two of the largest particle diameters long (2 × {} m = {} m)",
+                2.0 * sizes.largest(),
+                4.0 * sizes.largest()
+            ),
+        ));
+    }
     positive("drum.rotation_period", d.rotation_period)?;
     if let Some(tw) = d.wall_temperature {
         temperature("drum.wall_temperature", tw)?;

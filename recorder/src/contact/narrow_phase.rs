@@ -11,6 +11,7 @@
 use super::contact_sphere_sphere::overlapping;
 use super::pair_batch::PairBatch;
 use crate::math::*;
+use crate::periodic::{nearest_image, AxialPeriod};
 use std::ops::Range;
 
 /// The list entries of a run of slots, and where their histories begin.
@@ -35,10 +36,16 @@ pub fn scan(
     entries: &ListEntries,
     pos: &[Vec3],
     radius: &[f64],
+    period: Option<AxialPeriod>,
     touching: &mut [bool],
     batch: &mut PairBatch,
     full: &mut impl FnMut(&mut PairBatch),
 ) -> u64 {
+    if period.is_some() {
+        // the seam's nearest image is taken entry by entry; a periodic section is a thin
+        // slice of a kiln, where this scan is a small part of the step
+        return scan_entries(entries, pos, radius, period, touching, batch, full);
+    }
     #[cfg(target_arch = "x86_64")]
     {
         if batch.simd() == crate::simd::Simd::Avx512 {
@@ -47,7 +54,7 @@ pub fn scan(
             return unsafe { scan_avx512(entries, pos, radius, touching, batch, full) };
         }
     }
-    scan_entries(entries, pos, radius, touching, batch, full)
+    scan_entries(entries, pos, radius, None, touching, batch, full)
 }
 
 /// One entry at a time.
@@ -56,6 +63,7 @@ fn scan_entries(
     entries: &ListEntries,
     pos: &[Vec3],
     radius: &[f64],
+    period: Option<AxialPeriod>,
     touch: &mut [bool],
     batch: &mut PairBatch,
     full: &mut impl FnMut(&mut PairBatch),
@@ -73,7 +81,7 @@ fn scan_entries(
         let (first, last) = (offsets[i] as usize, offsets[i + 1] as usize);
         for (e, &partner) in (first..last).zip(&partners[first..last]) {
             let j = partner as usize;
-            let delta = sub(pos_i, pos[j]);
+            let delta = nearest_image(sub(pos_i, pos[j]), period);
             let local = e - first_entry;
             let old = if touch[local] { touched_before } else { fresh };
             touched_before += u32::from(touch[local]);
@@ -228,7 +236,9 @@ mod tests {
             // SAFETY: the features were checked just above
             unsafe { scan_avx512(entries, pos, radius, &mut touch, &mut batch, &mut take) }
         } else {
-            scan_entries(entries, pos, radius, &mut touch, &mut batch, &mut take)
+            scan_entries(
+                entries, pos, radius, None, &mut touch, &mut batch, &mut take,
+            )
         };
         take(&mut batch);
         assert_eq!(batch.len(), 0);

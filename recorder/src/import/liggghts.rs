@@ -6,11 +6,11 @@
 
 use super::dump::{DumpSet, FramePart, Items};
 use super::ImportError;
-use crate::case::{Case, ContactArea, EndCaps};
+use crate::case::{Case, ContactArea};
 use crate::heat::ConductionLaw;
 use crate::record::metadata::{recording_info, wall_infos, RunAtT0};
 use crate::record::{ContactSampler, RecordOptions};
-use crate::wall::{WallMotion, WallSet};
+use crate::wall::WallSet;
 use std::path::{Path, PathBuf};
 use tdex_format::{RecordingCosts, RecordingSummary, RecordingWriter, Snapshot};
 
@@ -117,11 +117,7 @@ pub fn import(
             t0.len()
         )));
     }
-    let motion = match case.drum.end_caps {
-        EndCaps::Rotating => WallMotion::Rotating,
-        EndCaps::Fixed => WallMotion::Fixed,
-    };
-    let mut walls = WallSet::drum(case.drum.radius, case.drum.length, motion);
+    let mut walls = WallSet::of_drum(&case.drum);
     walls.mantle_temperature = case.drum.wall_temperature;
     let run = RunAtT0 {
         particles,

@@ -1,9 +1,11 @@
 //! A uniform grid of cubic cells over a fixed box; positions outside are clamped to the edge
 //! cells, which keeps every pair closer than a cell size in adjacent cells. Cells are numbered
 //! layer by layer along the axis with the most cells, so that slot order (cells in index
-//! order) puts every half-list partner in the particle's own layer or the next one.
+//! order) puts every half-list partner in the particle's own layer or the next one. In a
+//! drum periodic along its axis the grid wraps along y, which is then never the layer axis.
 
 use crate::math::Vec3;
+use crate::periodic::AxialPeriod;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct CellGrid {
@@ -15,20 +17,39 @@ pub struct CellGrid {
     /// Offsets `[dx, dy, dz]` of the cells at or after a cell in index order: its own and
     /// the 13 ahead of it, the half stencil of a half list.
     pub forward: [[i64; 3]; 14],
+    /// The period along y when the grid wraps there (its box then spans exactly one).
+    pub period: Option<AxialPeriod>,
 }
 
 impl CellGrid {
     /// A grid covering `[lo, hi]` with cells at least `min_cell` wide.
     pub fn new(lo: Vec3, hi: Vec3, min_cell: f64) -> Self {
+        Self::build(lo, hi, min_cell, None)
+    }
+
+    /// A grid covering `[lo, hi]` that wraps along y, with period `hi[1] − lo[1]`. The
+    /// positions along y must lie in `[lo[1], hi[1])`; a remainder of the period shorter
+    /// than a cell joins the last cell, which keeps every pair closer than a cell in
+    /// adjacent cells, the seam included.
+    pub fn periodic_along_y(lo: Vec3, hi: Vec3, min_cell: f64) -> Self {
+        let period = AxialPeriod {
+            length: hi[1] - lo[1],
+        };
+        Self::build(lo, hi, min_cell, Some(period))
+    }
+
+    fn build(lo: Vec3, hi: Vec3, min_cell: f64, period: Option<AxialPeriod>) -> Self {
         let mut dims = [1usize; 3];
         for k in 0..3 {
             dims[k] = (((hi[k] - lo[k]) / min_cell).floor() as usize).max(1);
         }
         // the longest axis is the layer axis: the most layers, the most parallel tasks; of
         // equal ones the first, so that a drum (axis y, gravity −z) is not cut into
-        // horizontal layers its bed only half fills
+        // horizontal layers its bed only half fills. A wrapping axis is never the layer
+        // axis: a pair across the seam would join the last layer to the first, which the
+        // even/odd layer tasks of the pair stage could then write at the same time.
         let mut axes = [0, 1, 2];
-        axes.sort_by_key(|&k| (dims[k], std::cmp::Reverse(k)));
+        axes.sort_by_key(|&k| (period.is_none() || k != 1, dims[k], std::cmp::Reverse(k)));
         let [a, b, l] = axes;
         let mut forward = [[0i64; 3]; 14];
         let mut k = 0;
@@ -55,6 +76,7 @@ impl CellGrid {
             dims,
             axes,
             forward,
+            period,
         }
     }
 

@@ -10,6 +10,7 @@ use crate::contact::contact_sphere_sphere::{effective, overlapping};
 use crate::contact::ContactHistory;
 use crate::math::*;
 use crate::particles::{ParticleSet, PermuteScratch};
+use crate::periodic::AxialPeriod;
 use crate::slices::{for_each_task, pieces_at, slices_indexed_alike};
 use crate::wall::WallSet;
 use rayon::prelude::*;
@@ -471,6 +472,9 @@ impl Search<'_> {
     /// cell and the 13 after it in a fixed order (earlier cells hold only slots below `i`).
     #[inline(always)]
     fn partners(&self, i: usize, mut found: impl FnMut(usize, bool)) {
+        if let Some(period) = self.grid.period {
+            return self.partners_across_seam(i, period, found);
+        }
         let (grid, pos, radius) = (self.grid, self.pos, self.radius);
         let ci = grid.coords(pos[i]);
         for d in &grid.forward {
@@ -489,6 +493,50 @@ impl Search<'_> {
                 let delta = sub(pos[i], pos[j]);
                 if norm2(delta) < cut * cut {
                     found(j, overlapping(delta, radius[i], radius[j]).is_some());
+                }
+            }
+        }
+    }
+
+    /// [`Search::partners`] in a grid that wraps along y: the half stencil's "cells ahead"
+    /// wrap to cells behind, so every distinct cell of the 27 around `i`'s is scanned for
+    /// partners `j > i`, each pair once, from its lower slot, with the centre vector taken to
+    /// the nearest image. A section one or two cells long reaches the same cell from both
+    /// sides: it is scanned once. The partners stay in `i`'s layer or the next, as the
+    /// pair stage needs, since y is not the layer axis.
+    #[inline(always)]
+    fn partners_across_seam(
+        &self,
+        i: usize,
+        period: AxialPeriod,
+        mut found: impl FnMut(usize, bool),
+    ) {
+        let (grid, pos, radius) = (self.grid, self.pos, self.radius);
+        let ci = grid.coords(pos[i]);
+        let mut scanned = [usize::MAX; 27];
+        let mut n_scanned = 0;
+        for dz in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    let (x, z) = (ci[0] as i64 + dx, ci[2] as i64 + dz);
+                    if x < 0 || z < 0 || x >= grid.dims[0] as i64 || z >= grid.dims[2] as i64 {
+                        continue;
+                    }
+                    let y = (ci[1] as i64 + dy).rem_euclid(grid.dims[1] as i64);
+                    let cell = grid.index([x as usize, y as usize, z as usize]);
+                    if scanned[..n_scanned].contains(&cell) {
+                        continue;
+                    }
+                    scanned[n_scanned] = cell;
+                    n_scanned += 1;
+                    let first = (self.cell_start[cell] as usize).max(i + 1);
+                    for j in first..self.cell_start[cell + 1] as usize {
+                        let cut = radius[i] + radius[j] + self.skin;
+                        let delta = period.nearest_image(sub(pos[i], pos[j]));
+                        if norm2(delta) < cut * cut {
+                            found(j, overlapping(delta, radius[i], radius[j]).is_some());
+                        }
+                    }
                 }
             }
         }

@@ -1,5 +1,6 @@
 //! Analytic walls: the rotating cylinder mantle of the drum and its flat end caps.
 
+use crate::case::{Drum, EndCaps};
 use crate::math::*;
 
 /// A wall surface. The drum axis is `y` through the origin.
@@ -63,6 +64,28 @@ impl WallSet {
             angular_velocity: 0.0,
             mantle_temperature: None,
         }
+    }
+
+    /// The walls of a case's drum: the mantle and its end caps, or the mantle alone in a
+    /// periodic section.
+    pub fn of_drum(drum: &Drum) -> Self {
+        let caps = match drum.end_caps {
+            EndCaps::Rotating => WallMotion::Rotating,
+            EndCaps::Fixed => WallMotion::Fixed,
+            EndCaps::Periodic => {
+                return Self {
+                    walls: vec![(
+                        Wall::Mantle {
+                            radius: drum.radius,
+                        },
+                        WallMotion::Rotating,
+                    )],
+                    angular_velocity: 0.0,
+                    mantle_temperature: None,
+                }
+            }
+        };
+        Self::drum(drum.radius, drum.length, caps)
     }
 
     pub fn len(&self) -> usize {
