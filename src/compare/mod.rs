@@ -2,6 +2,7 @@
 //! §7): Voronoi-cell errors, the Eq. 10 energy-transfer error, hot/cold group means. The
 //! same measures between two DEM runs of one case give the floor no extrapolation can beat.
 
+pub mod classes;
 pub mod draws;
 pub mod floor;
 pub mod metrics;
@@ -74,6 +75,16 @@ pub struct Comparison {
     pub verdict: Verdict,
     /// Extrapolated `t_k` without a DEM reference (recorded with a smaller `--reference`).
     pub unreferenced: Vec<u32>,
+    /// A bed of several particle sizes: each size class's mean temperature and the radial
+    /// segregation index, for every DEM run and the second field. Absent for a bed of one
+    /// size, and then left out of the JSON.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub size_classes: Option<classes::ClassComparison>,
+    /// The number of distinct radii of a bed with more than [`classes::MAX_CLASSES`] of
+    /// them (a continuous size distribution), which is compared without size classes;
+    /// absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub distinct_radii: Option<usize>,
 }
 
 /// The errors at one `t_k`.
@@ -458,6 +469,9 @@ pub fn compare_runs(
             .find(|d| (d.time - time).abs() <= half_step)
             .map(|d| d.index)
     };
+    let size_classes = classes::SizeClasses::of_run(&dem);
+    // the second field's class states, one per compared t_k, made as its snapshots stream by
+    let mut class_states: Vec<(classes::ClassState, bool)> = Vec::new();
     let mut role_cells: Option<(Vec<[f64; 3]>, Vec<u32>)> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
@@ -536,6 +550,7 @@ pub fn compare_runs(
                 )
             })
             .max_by(|a, b| a.abs().total_cmp(&b.abs()));
+        let within_recording = recorded_until.is_none_or(|until| after.index <= until);
         periods.push(PeriodComparison {
             k,
             t: after.time,
@@ -582,8 +597,15 @@ pub fn compare_runs(
                 .iter()
                 .map(|s| metrics::bed_mean(&s.radius, &s.temp))
                 .collect(),
-            within_recording: recorded_until.is_none_or(|until| after.index <= until),
+            within_recording,
         });
+        if let Some(size_classes) = &size_classes {
+            let state = classes::ClassState {
+                k,
+                ..classes::ClassState::of(size_classes, after)
+            };
+            class_states.push((state, within_recording));
+        }
     }
     if periods.is_empty() {
         return Err(CompareError::NoSharedInstant {
@@ -595,6 +617,9 @@ pub fn compare_runs(
     let (hot_particles, cold_particles) =
         groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
     let verdict = Verdict::of(&periods, 1 + others.len(), departure, contrast_kind);
+    let distinct_radii = classes::too_many_classes(&dem);
+    let size_classes =
+        size_classes.map(|sizes| classes::ClassComparison::new(sizes, &dem, &others, class_states));
     Ok(Comparison {
         recording: rec_path,
         extrapolation: extra_path,
@@ -612,6 +637,8 @@ pub fn compare_runs(
         dem_runs_series,
         verdict,
         unreferenced,
+        size_classes,
+        distinct_radii,
     })
 }
 
@@ -787,6 +814,16 @@ pub fn table(c: &Comparison) -> String {
         );
     }
     s += &format!("verdict: {}\n", c.verdict.text);
+    if let Some(size_classes) = &c.size_classes {
+        s += &classes::table(size_classes, c.second);
+    }
+    if let Some(n) = c.distinct_radii {
+        s += &format!(
+            "{n} distinct particle radii: a continuous size distribution, compared on the bed \
+             mean alone (size classes are compared up to {} radii)\n",
+            classes::MAX_CLASSES
+        );
+    }
     s
 }
 
@@ -823,7 +860,95 @@ pub fn csv(c: &Comparison) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::span_of;
+    use super::*;
+
+    /// A comparison of a bed without groups at t2 and t3 with one twin, its size classes
+    /// `size_classes`.
+    fn comparison(size_classes: Option<classes::ClassComparison>) -> Comparison {
+        let periods: Vec<PeriodComparison> = [2u32, 3]
+            .iter()
+            .map(|&k| PeriodComparison {
+                k,
+                t: 0.5 * f64::from(k),
+                eps_abs: 0.2,
+                cells_used: 200,
+                eps_rel: None,
+                energy_error: None,
+                hot_mean_dem: None,
+                hot_mean_extra: None,
+                cold_mean_dem: None,
+                cold_mean_extra: None,
+                bed_mean_dem: 310.0,
+                bed_mean_extra: 309.5,
+                contrast: None,
+                floor_eps_abs: Some(0.25),
+                floor_eps_abs_min: Some(0.25),
+                floor_eps_abs_max: Some(0.25),
+                floor_eps_rel: None,
+                eps_abs_to_dem_runs: Some(0.2),
+                ratio_to_floor: Some(0.8),
+                dem_runs_ratio_to_others: Vec::new(),
+                dem_runs_outside_others_range: Vec::new(),
+                floor_energy_error: None,
+                dem_runs_hot_mean: Vec::new(),
+                dem_runs_cold_mean: Vec::new(),
+                dem_runs_bed_mean: vec![310.2],
+                within_recording: false,
+            })
+            .collect();
+        let departure = floor::Departure::WithTheTwins;
+        Comparison {
+            recording: "run.mcap".into(),
+            extrapolation: "extra.mcap".into(),
+            second: SecondKind::Extrapolation,
+            particles: 6,
+            cells: 200,
+            seed: 1,
+            hot_particles: 0,
+            cold_particles: 0,
+            dem_runs: 2,
+            departure,
+            contrast: ContrastKind::None,
+            verdict: Verdict::of(&periods, 2, departure, ContrastKind::None),
+            periods,
+            dem_series: Vec::new(),
+            dem_runs_series: Vec::new(),
+            unreferenced: Vec::new(),
+            size_classes,
+            distinct_radii: None,
+        }
+    }
+
+    #[test]
+    fn the_size_classes_follow_the_table_and_a_bed_of_one_size_has_none() {
+        let one_size = comparison(None);
+        let plain = table(&one_size);
+        assert!(!plain.contains("size class"), "{plain}");
+        let json = serde_json::to_string(&one_size).expect("serialisable");
+        assert!(!json.contains("size_classes") && !json.contains("distinct_radii"));
+
+        let three = comparison(Some(classes::synthetic::three_class_comparison()));
+        let text = table(&three);
+        // the one-size table, then the classes
+        let classes_text = text.strip_prefix(plain.as_str()).expect("same table first");
+        assert!(
+            classes_text.starts_with("size classes at t_3"),
+            "{classes_text}"
+        );
+        assert!(classes_text
+            .contains("class 3 (2 mm) mean within the DEM runs' spread at 1 of 2 compared t_k\n"));
+        let json = serde_json::to_value(&three).expect("serialisable");
+        let series = &json["size_classes"]["extra_series"];
+        assert_eq!(series[1]["k"], 3);
+        assert_eq!(
+            series[1]["mean_temperature"],
+            serde_json::json!([302.0, 312.0, 322.0])
+        );
+        assert_eq!(
+            json["size_classes"]["radii"],
+            serde_json::json!([0.001, 0.0015, 0.002])
+        );
+    }
 
     #[test]
     fn runs_of_three_or_more_indices_are_shortened() {

@@ -5,6 +5,7 @@
 use super::costs::{CostTable, DemPeriodSource, TABLE_PERIODS};
 use super::document::{bold, code, link, para, text, Block, Document};
 use super::prediction::{Point, Prediction};
+use crate::compare::classes::{self, ClassComparison};
 use crate::compare::{Comparison, ContrastKind, PeriodComparison};
 use crate::fmt::trim_zeros;
 use tdex_format::extrapolation::{Roles, Symmetry};
@@ -24,6 +25,8 @@ pub const WALL_HEAT_SVG: &str = "wall_heat.svg";
 pub const SPREAD_SVG: &str = "spread.svg";
 pub const LACEY_SVG: &str = "lacey.svg";
 pub const FIELDS_SVG: &str = "fields.svg";
+pub const CLASS_MEANS_SVG: &str = "class_means.svg";
+pub const SEGREGATION_SVG: &str = "segregation.svg";
 
 /// Everything the text is made from.
 pub struct Inputs<'a> {
@@ -448,7 +451,12 @@ pub fn document(inp: &Inputs) -> Document {
 
     prediction_section(&mut d, inp);
     match c {
-        Some(c) => errors_section(&mut d, c),
+        Some(c) => {
+            errors_section(&mut d, c);
+            if let Some(size_classes) = &c.size_classes {
+                size_classes_section(&mut d, size_classes);
+            }
+        }
         None => {
             d.push(Block::Heading(2, "Errors".into()));
             d.push(para(vec![text(
@@ -784,6 +792,102 @@ fn errors_section(d: &mut Document, c: &Comparison) {
     );
 }
 
+/// A bed of several particle sizes: each class's mean temperature and the radial
+/// segregation index at the last compared `t_k`, whether they stayed within the DEM runs'
+/// spread, and their plots over time.
+fn size_classes_section(d: &mut Document, c: &ClassComparison) {
+    let Some(last) = c.extra_series.last() else {
+        return;
+    };
+    let k = last.k;
+    let dem = c.dem_at(k);
+    d.push(Block::Heading(2, "Size classes".into()));
+    d.push(para(vec![
+        text(format!(
+            "The bed holds {} particle sizes, each a size class of one radius. For each class: \
+             the ",
+            c.radii.len()
+        )),
+        bold("mean temperature"),
+        text(" of the particles of that radius (one radius, so no weighting within a class), and its "),
+        bold("distance"),
+        text(
+            ": the mean distance of its particles from the bed's centroid in the \
+             cross-section (x, z) over that of all particles (1: where the bed is on average; \
+             below 1 the class gathers in the core, above 1 it rides outside, nearer the \
+             mantle). The ",
+        ),
+        bold("segregation index"),
+        text(
+            " is the largest class's distance minus the smallest's: 0 for a mixed bed, \
+             positive when the large particles ride outside the small ones. The DEM runs' \
+             spread is the smallest to the largest value of the reference and its twins.",
+        ),
+    ]));
+    let of_dem = |f: &dyn Fn(&classes::ClassState) -> String| dem.map_or("-".into(), f);
+    let rows = c
+        .radii
+        .iter()
+        .enumerate()
+        .map(|(class, &r)| {
+            vec![
+                (class + 1).to_string(),
+                classes::millimetres(r),
+                c.particles[class].to_string(),
+                of_dem(&|s| classes::temperature(s.mean_temperature[class])),
+                classes::range(c.mean_spread(class, k), classes::temperature),
+                classes::temperature(last.mean_temperature[class]),
+                of_dem(&|s| classes::dimensionless(s.segregation.relative_distance[class])),
+                classes::dimensionless(last.segregation.relative_distance[class]),
+            ]
+        })
+        .collect();
+    d.push(para(vec![text(format!(
+        "At t_{k}, the last compared t_k:"
+    ))]));
+    d.push(Block::Table {
+        header: [
+            "Class",
+            "Radius (mm)",
+            "Particles",
+            "T̄ DEM (K)",
+            "T̄ DEM runs min..max (K)",
+            "T̄ extrapolated (K)",
+            "Distance DEM",
+            "Distance extrapolated",
+        ]
+        .map(String::from)
+        .to_vec(),
+        rows,
+        numeric: true,
+    });
+    d.push(para(vec![text(format!(
+        "Segregation index at t_{k}: DEM {}, DEM runs {}, extrapolated {}.",
+        of_dem(&|s| classes::dimensionless(s.segregation.index)),
+        classes::range(c.index_spread(k), classes::dimensionless),
+        classes::dimensionless(last.segregation.index),
+    ))]));
+    d.push(Block::List(
+        classes::verdict_lines(c)
+            .into_iter()
+            .map(|l| vec![text(l)])
+            .collect(),
+    ));
+    figure(
+        d,
+        "The mean temperature of each size class over time, the DEM runs' and the \
+         extrapolation's at the compared t_k: ",
+        CLASS_MEANS_SVG,
+        "Mean temperature of each particle size over time",
+    );
+    figure(
+        d,
+        "The segregation index over time: ",
+        SEGREGATION_SVG,
+        "Radial segregation index of the particle sizes over time",
+    );
+}
+
 /// A paragraph `caption` linking `file`, then the image itself.
 fn figure(d: &mut Document, caption: &str, file: &str, alt: &str) {
     d.push(para(vec![text(caption), link(file, file), text(".")]));
@@ -979,6 +1083,100 @@ fn field_section(d: &mut Document, inp: &Inputs) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A bed of 3 classes at t_k: 2 particles of 1 mm in the core, 2 of 1.5 mm between, 2
+    /// of 2 mm outside, at `base` + 0, 10 and 20 K.
+    fn three_classes(k: u32, base: f64) -> tdex_format::Snapshot {
+        let bed = [
+            ((-0.01, 0.0), 0.001, 0.0),
+            ((0.01, 0.0), 0.001, 0.0),
+            ((0.0, -0.02), 0.0015, 10.0),
+            ((0.0, 0.02), 0.0015, 10.0),
+            ((-0.03, 0.0), 0.002, 20.0),
+            ((0.03, 0.0), 0.002, 20.0),
+        ];
+        tdex_format::Snapshot {
+            index: k,
+            time: 0.5 * f64::from(k),
+            id: (0..6).collect(),
+            pos: bed.iter().map(|&((x, z), _, _)| [x, 0.0, z]).collect(),
+            radius: bed.iter().map(|&(_, r, _)| r).collect(),
+            temp: bed.iter().map(|&(_, _, t)| base + t).collect(),
+            vel: vec![[0.0; 3]; 6],
+        }
+    }
+
+    #[test]
+    fn a_bed_of_three_sizes_has_its_size_classes_section() {
+        // the twin 0.5 K warmer than the reference; the extrapolation within their spread
+        // at t2, 1 K too cold at t3
+        let dem: Vec<_> = (0..4)
+            .map(|k| three_classes(k, 300.0 + f64::from(k)))
+            .collect();
+        let twin: Vec<_> = (1..4)
+            .map(|k| three_classes(k, 300.5 + f64::from(k)))
+            .collect();
+        let sizes = classes::SizeClasses::of_run(&dem).expect("three classes");
+        let compared = [three_classes(2, 302.25), three_classes(3, 302.0)]
+            .iter()
+            .map(|s| (classes::ClassState::of(&sizes, s), false))
+            .collect();
+        let c = ClassComparison::new(sizes, &dem, &[twin], compared);
+        let mut d = Document::default();
+        size_classes_section(&mut d, &c);
+        let md = d.markdown();
+        assert!(md.contains("## Size classes"), "{md}");
+        assert!(md.contains("The bed holds 3 particle sizes"), "{md}");
+        assert!(md.contains("At t_3, the last compared t_k:"), "{md}");
+        let row = |cells: &[&str]| format!("| {} |", cells.join(" | "));
+        for cells in [
+            [
+                "1",
+                "1",
+                "2",
+                "303.000",
+                "303.000..303.500",
+                "302.000",
+                "0.500",
+                "0.500",
+            ],
+            [
+                "2",
+                "1.5",
+                "2",
+                "313.000",
+                "313.000..313.500",
+                "312.000",
+                "1.000",
+                "1.000",
+            ],
+            [
+                "3",
+                "2",
+                "2",
+                "323.000",
+                "323.000..323.500",
+                "322.000",
+                "1.500",
+                "1.500",
+            ],
+        ] {
+            assert!(md.contains(&row(&cells)), "{md}");
+        }
+        assert!(md.contains(
+            "Segregation index at t_3: DEM 1.000, DEM runs 1.000..1.000, extrapolated 1.000."
+        ));
+        assert!(
+            md.contains("class 1 (1 mm) mean within the DEM runs' spread at 1 of 2 compared t_k")
+        );
+        assert!(md.contains("segregation index within the DEM runs' spread at 2 of 2 compared t_k"));
+        assert!(md.contains(CLASS_MEANS_SVG) && md.contains(SEGREGATION_SVG));
+        // the plots draw every class and the DEM runs
+        let means = super::super::plots::class_means(&c).expect("drawn");
+        assert!(means.contains("r = 1.5 mm") && means.contains("DEM twin"));
+        let index = super::super::plots::segregation(&c).expect("drawn");
+        assert!(index.contains("extrapolated"));
+    }
 
     #[test]
     fn numbers_are_formatted_to_significant_digits() {

@@ -14,8 +14,8 @@ use crate::cli::ReportPlan;
 use crate::compare::{self, Comparison};
 use anyhow::{Context, Result};
 use content::{
-    BED_MEAN_SVG, DURATIONS_SVG, ERRORS_SVG, FIELDS_SVG, FIELD_SVG, LACEY_SVG, MEANS_SVG,
-    SPEEDUP_SVG, SPREAD_SVG, WALL_HEAT_SVG,
+    BED_MEAN_SVG, CLASS_MEANS_SVG, DURATIONS_SVG, ERRORS_SVG, FIELDS_SVG, FIELD_SVG, LACEY_SVG,
+    MEANS_SVG, SEGREGATION_SVG, SPEEDUP_SVG, SPREAD_SVG, WALL_HEAT_SVG,
 };
 use costs::CostTable;
 use prediction::{Measures, Prediction};
@@ -27,7 +27,7 @@ use tdex_format::{ExtrapolationReader, RecordingReader};
 /// removed once the new report is in place.
 const MARKDOWN: &str = "report.md";
 const HTML: &str = "report.html";
-const ALL_FILES: [&str; 12] = [
+const ALL_FILES: [&str; 14] = [
     MARKDOWN,
     HTML,
     BED_MEAN_SVG,
@@ -40,6 +40,8 @@ const ALL_FILES: [&str; 12] = [
     SPEEDUP_SVG,
     DURATIONS_SVG,
     FIELD_SVG,
+    CLASS_MEANS_SVG,
+    SEGREGATION_SVG,
 ];
 
 pub fn run(plan: &ReportPlan) -> Result<()> {
@@ -222,6 +224,16 @@ pub fn write_with(
     ));
     if let Some(c) = comparison {
         svgs.push((ERRORS_SVG, plot(ERRORS_SVG, plots::errors(c))?));
+        if let Some(size_classes) = &c.size_classes {
+            svgs.push((
+                CLASS_MEANS_SVG,
+                plot(CLASS_MEANS_SVG, plots::class_means(size_classes))?,
+            ));
+            svgs.push((
+                SEGREGATION_SVG,
+                plot(SEGREGATION_SVG, plots::segregation(size_classes))?,
+            ));
+        }
         if let Ok(t) = &costs {
             svgs.push((
                 SPEEDUP_SVG,

@@ -4,6 +4,7 @@
 
 use super::costs::CostTable;
 use super::prediction::{Point, Prediction};
+use crate::compare::classes::{self, ClassComparison, ClassState};
 use crate::compare::{Comparison, ContrastKind, GroupMeans, PeriodComparison};
 use anyhow::Result;
 use plotters::chart::MeshStyle;
@@ -1278,6 +1279,84 @@ pub fn fields(snaps: &[(&Snapshot, String)], drum_radius: Option<f64>) -> Result
             Rectangle::new([(0.0, t(a)), (1.0, t(top))], colour((a + b) / 2.0).filled())
         }))?;
         Ok(())
+    })
+}
+
+/// The size classes' colours, smallest radius first (cycled past six classes).
+const CLASS_COLOURS: [RGBColor; 6] = [
+    RGBColor(35, 80, 200),
+    RGBColor(20, 140, 70),
+    RGBColor(230, 140, 20),
+    RGBColor(200, 35, 35),
+    RGBColor(130, 60, 170),
+    RGBColor(120, 80, 40),
+];
+
+/// `(t, f(state))` of the class states where `f` is a number.
+fn class_line(states: &[ClassState], f: impl Fn(&ClassState) -> f64) -> Line {
+    states
+        .iter()
+        .map(|s| (s.t, f(s)))
+        .filter(|p| p.1.is_finite())
+        .collect()
+}
+
+/// `f` of the reference's, the further DEM runs' and the extrapolation's class states.
+fn class_lines(c: &ClassComparison, f: impl Fn(&ClassState) -> f64) -> (Line, Vec<Line>, Line) {
+    (
+        class_line(&c.dem_series, &f),
+        c.dem_runs_series
+            .iter()
+            .map(|s| class_line(s, &f))
+            .collect(),
+        class_line(&c.extra_series, &f),
+    )
+}
+
+/// The mean temperature of each size class over time: the DEM reference, its further runs
+/// and the extrapolation at the compared `t_k`.
+pub fn class_means(c: &ClassComparison) -> Result<String> {
+    render(SIZE, |root| {
+        let lines: Vec<(Line, Vec<Line>, Line)> = (0..c.radii.len())
+            .map(|class| class_lines(c, |s| s.mean_temperature[class]))
+            .collect();
+        let all: Vec<&[(f64, f64)]> = lines
+            .iter()
+            .flat_map(|(dem, runs, extra)| {
+                [dem.as_slice(), extra.as_slice()]
+                    .into_iter()
+                    .chain(runs.iter().map(Vec::as_slice))
+            })
+            .collect();
+        let x = span(all.iter().flat_map(|s| s.iter().map(|q| q.0)), &[], 0.02);
+        let y = value_span(&all, &[], 0.08);
+        let mut chart = chart(root, "Mean temperature of each particle size", x, y)?;
+        draw_axes(&mut chart, TIME, "mean temperature of the class (K)")?;
+        for (class, (dem, runs, extra)) in lines.iter().enumerate() {
+            let colour = CLASS_COLOURS[class % CLASS_COLOURS.len()];
+            let what = format!(", r = {} mm", classes::millimetres(c.radii[class]));
+            with_dem(&mut chart, extra, (dem, runs), (colour, colour), &what)?;
+        }
+        legend(&mut chart, &all)
+    })
+}
+
+/// The radial segregation index over time: the DEM reference, its further runs and the
+/// extrapolation at the compared `t_k`.
+pub fn segregation(c: &ClassComparison) -> Result<String> {
+    render(SIZE, |root| {
+        let (dem, runs, extra) = class_lines(c, |s| s.segregation.index);
+        let all = series_of(&[&dem, &extra], &[&runs]);
+        let x = span(all.iter().flat_map(|s| s.iter().map(|q| q.0)), &[], 0.02);
+        let y = value_span(&all, &[0.0], 0.08);
+        let mut chart = chart(root, "Radial segregation of the particle sizes", x, y)?;
+        draw_axes(
+            &mut chart,
+            TIME,
+            "segregation index (largest − smallest class)",
+        )?;
+        with_dem(&mut chart, &extra, (&dem, &runs), (BLACK, DEM), "")?;
+        legend(&mut chart, &all)
     })
 }
 
