@@ -12,6 +12,14 @@ type 2 = wall (same E, nu, k, c as the particles).  Python stdlib only.
 
 --facets F sets the number of facets around the mantle (default 96).
 
+A bed of several sizes (particles.classes or particles.distribution) is resolved into classes
+as tdex does (size_classes(), after recorder/src/case/sizes.rs); each class is a
+particletemplate/sphere and one particledistribution/discrete takes them with their mass
+fractions (count x r^3).  The deck then also dumps `id radius x y z f_Temp` at t0 and every
+half revolution of heating (dump_classes.STEP).  With `end_caps = "periodic"` the box is
+periodic along y with the period L (boundary f p f) and the mesh is the mantle alone,
+drum_mantle.stl.  A Young's modulus below 5 MPa gets `soft_particles yes`.
+
 A heated mantle (`drum.wall_temperature`) is its own mesh, drum_mantle.stl, with
 `temperature Tw` (fix heat/gran/conduction then conducts between it and the particles
 touching it, with the wall's conductivity `drum.wall_conductivity`), and the end caps
@@ -82,6 +90,50 @@ def next_prime(n):
     return n
 
 
+def size_classes(p):
+    """The bed's sizes as recorder/src/case/sizes.rs resolves them: (radii, counts), radii
+    increasing, counts summing to particles.count."""
+    N = p["count"]
+    if "radius" in p:
+        return [p["radius"]], [N]
+    if "classes" in p:
+        cl = sorted(p["classes"], key=lambda c: c["radius"])
+        radius, fraction = [c["radius"] for c in cl], [c["fraction"] for c in cl]
+    else:
+        d = p["distribution"]
+        lo, hi, k = d["min_radius"], d["max_radius"], d["classes"]
+        m, sd = d["mean_radius"], d["std_radius"]
+        if d["shape"] == "normal":
+            cdf = lambda r: 0.5 * math.erfc(-((r - m) / sd) / math.sqrt(2.0))
+        elif d["shape"] == "lognormal":
+            s2 = math.log(1.0 + (sd / m) ** 2)
+            mu = math.log(m) - 0.5 * s2
+            cdf = lambda r: 0.5 * math.erfc(-((math.log(r) - mu) / math.sqrt(s2)) / math.sqrt(2.0))
+        else:
+            sys.exit(f"particles.distribution.shape = {d['shape']!r} is not supported")
+        width = (hi - lo) / k
+        edge = lambda b: lo + b * width
+        prob = [cdf(edge(b + 1)) - cdf(edge(b)) for b in range(k)]
+        total = sum(prob)
+        radius = [edge(b) + 0.5 * width for b in range(k)]
+        fraction = [q / total for q in prob]
+    if p.get("fractions", "number") == "mass":
+        w = [f / r ** 3 for r, f in zip(radius, fraction)]
+    elif p.get("fractions", "number") == "number":
+        w = list(fraction)
+    else:
+        sys.exit(f"particles.fractions = {p['fractions']!r} is not supported")
+    shares = [x / sum(w) for x in w]
+    # floors, then one each to the largest remainders (ties to the smaller radius)
+    exact = [s * N for s in shares]
+    counts = [math.floor(x) for x in exact]
+    order = sorted(range(len(exact)), key=lambda c: (-(exact[c] - math.floor(exact[c])), c))
+    for c in order[:max(0, N - sum(counts))]:
+        counts[c] += 1
+    kept = [(r, n) for r, n in zip(radius, counts) if n > 0]
+    return [r for r, _ in kept], [n for _, n in kept]
+
+
 def steps(seconds, dt, what):
     n = round(seconds / dt)
     if abs(n * dt - seconds) > 1e-9 * max(1.0, seconds):
@@ -106,6 +158,34 @@ dump_modify dc format "%.0f %.0f %.0f %.17g"
 undump dc
 @wall_undump@@restart_rotation@
 run @nrest@"""
+
+
+CLASS_DUMPS = """\
+# a bed of several sizes: the atoms at t0 and every half revolution of heating (steps
+# @nstart@ + k @nhalf@), for the size classes' mean temperatures and segregation
+variable clnext equal @nstart@+@nhalf@*(floor((step-@nstart@)/@nhalf@)+1)
+dump dcl all custom 1 dump_classes.* id radius x y z f_Temp
+dump_modify dcl every v_clnext first yes sort id format "%d %.17g %.17g %.17g %.17g %.17g"
+"""
+
+
+def several_sizes(start, v, radii, counts, rho):
+    """The start's insertion for a bed of several sizes: a particletemplate/sphere per class
+    and a particledistribution/discrete of the classes' mass fractions (count x r^3)."""
+    mass = [n * r ** 3 for r, n in zip(radii, counts)]
+    seeds = [v["seed1"]] + [None] * (len(radii) - 1)
+    q = v["seed3"]
+    for k in range(1, len(radii)):  # the further templates' seeds: the primes after seed3
+        q = next_prime(q + 1)
+        seeds[k] = q
+    templates = "\n".join(
+        f"fix pts{k + 1} all particletemplate/sphere {seeds[k]} atom_type 1 density constant {rho} "
+        f"radius constant {r!r}" for k, r in enumerate(radii))
+    dist = " ".join(f"pts{k + 1} {m / sum(mass)!r}" for k, m in enumerate(mass))
+    start = replace_once(start, f"fix pts all particletemplate/sphere {v['seed1']} atom_type 1 "
+                         f"density constant {rho} radius constant {v['rp']}\n", templates + "\n")
+    return replace_once(start, f"fix pdd all particledistribution/discrete {v['seed2']} 1 pts 1.0\n",
+                        f"fix pdd all particledistribution/discrete {v['seed2']} {len(radii)} {dist}\n")
 
 
 def import_dumps(argv, nper, nstart, rotating, heated, caps_turn):
@@ -155,7 +235,7 @@ def replace_once(text, old, new):
     return text.replace(old, new)
 
 
-def heated_mantle(deck, v, caps_turn, Kw):
+def heated_mantle(deck, v, caps_turn, Kw, periodic=False):
     """The heated mantle's edits of the filled-in deck: the wall's conductivity (type 2) and,
     with rotating end caps, a second move/mesh for the caps mesh."""
     if Kw is not None and float(Kw) != float(v["k"]):
@@ -163,7 +243,7 @@ def heated_mantle(deck, v, caps_turn, Kw):
                             f"thermalConductivity peratomtype {v['k']} {float(Kw)!r}\n")
     deck = replace_once(deck, "# drum (adiabatic: no 'temperature' on the meshes)\n",
                         "# drum: the mantle held at its 'temperature' (conducts to the particles touching it),"
-                        " the end caps adiabatic\n")
+                        + (" no end caps (periodic along y)\n" if periodic else " the end caps adiabatic\n"))
     if caps_turn:
         rot = (f"fix rot all move/mesh mesh mantle rotate origin 0. 0. 0. axis 0. 1. 0. "
                f"period {v['period']}\n")
@@ -196,9 +276,19 @@ def main():
         T_hot, T_cold = temp["hot"], temp["cold"]
 
     out.mkdir(parents=True, exist_ok=True)
-    R, L, rp, dt = drum["radius"], drum["length"], p["radius"], t["dt"]
-    caps_turn = drum.get("end_caps", "rotating") != "fixed"
-    if Tw is not None:
+    radii, counts = size_classes(p)
+    # one size: the radius; several: the largest sets the skin and the insertion region
+    R, L, rp, dt = drum["radius"], drum["length"], p.get("radius", radii[-1]), t["dt"]
+    periodic = drum.get("end_caps", "rotating") == "periodic"
+    caps_turn = drum.get("end_caps", "rotating") == "rotating"
+    if periodic:
+        # no end caps: the mantle alone, the box periodic along y with the period L
+        write_stl(out / "drum_mantle.stl", R, L, caps=False, n_theta=facets)
+        curv = "" if default_curv or Tw is None else f" curvature {CURVATURE_FACTOR * 360.0 / facets!r}"
+        temp_kw = "" if Tw is None else f" temperature {float(Tw)!r}"
+        mesh_fixes = f"fix mantle all mesh/surface file drum_mantle.stl type 2{temp_kw}{curv}"
+        n_meshes, meshes, rotating = 1, "mantle", "mantle"
+    elif Tw is not None:
         # the heated mantle and the adiabatic end caps as two meshes; only the mantle has a temperature
         write_stl(out / "drum_mantle.stl", R, L, caps=False, n_theta=facets)
         write_stl(out / "drum_caps.stl", R, L, mantle=False, n_theta=facets)
@@ -255,14 +345,27 @@ def main():
     v["heat_runs"] = (import_dumps(sys.argv[3:], nper, v["nsettle"] + v["nspin"], rotating,
                                    Tw is not None, caps_turn)
                       if len(sys.argv) > 3 else f"run {v['nheat']}")
+    if periodic:  # the box spans exactly one period along y
+        v["by"] = L / 2
     v["box"] = f"region          domain block -{v['bx']} {v['bx']} -{v['by']} {v['by']} -{v['bx']} {v['bx']} units box\ncreate_box      2 domain"
     v["start"] = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), START)
+    if len(radii) > 1:
+        v["start"] = several_sizes(v["start"], v, radii, counts, mat["density"])
+        cl = dict(nstart=v["nsettle"] + v["nspin"],
+                  nhalf=steps(drum["rotation_period"] / 2, dt, "half of drum.rotation_period"))
+        v["heat_runs"] = re.sub(r"@(\w+)@", lambda m: str(cl[m.group(1)]), CLASS_DUMPS) + v["heat_runs"]
     deck = re.sub(r"@(\w+)@", lambda m: str(v[m.group(1)]), DECK)
+    if periodic:
+        deck = replace_once(deck, "boundary        f f f\n", "boundary        f p f\n")
+    if float(mat["youngs_modulus"]) < 5e6:  # LIGGGHTS refuses a softer E in SI units without it
+        deck = replace_once(deck, "units           si\n", "units           si\nsoft_particles  yes\n")
     if Tw is not None:
-        deck = heated_mantle(deck, v, caps_turn, drum.get("wall_conductivity"))
+        deck = heated_mantle(deck, v, caps_turn, drum.get("wall_conductivity"), periodic)
     (out / "in.drum").write_text(deck)
+    sizes = "" if len(radii) == 1 else " classes " + " ".join(f"{r!r}:{n}" for r, n in zip(radii, counts))
     print(f"wrote {out}/in.drum: N={v['N']} R={R} L={L} settle={v['nsettle']} spin={v['nspin']} "
-          f"heat={v['nheat']} steps, rolling={v['rolling']}, seeds {s1} {s2} {s3}")
+          f"heat={v['nheat']} steps, rolling={v['rolling']}, seeds {s1} {s2} {s3}{sizes}"
+          + (", periodic along y" if periodic else ""))
 
 
 if __name__ == "__main__":

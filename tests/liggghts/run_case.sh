@@ -4,6 +4,7 @@
 #   (the options go to deck_from_case.py)
 # OUTDIR gets: case.toml (copy), in.drum + drum STL (generated), log.liggghts, screen.txt,
 # marks.txt (per-phase wall/CPU marks), temps.txt (every 100 heating steps), dump_T.{start,end}.txt,
+# dump_classes.STEP for a bed of several sizes (t0 and every half revolution of heating),
 # summary.json.  Prefix with `nice -n 5` on a shared machine.
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
@@ -11,7 +12,7 @@ case_file="${1:?usage: run_case.sh CASE.toml OUTDIR}"
 out="${2:?usage: run_case.sh CASE.toml OUTDIR}"
 mkdir -p "$out"
 out="$(cd "$out" && pwd)"
-rm -f "$out"/{marks.txt,temps.txt,dump_T.start.txt,dump_T.end.txt,summary.json}
+rm -f "$out"/{marks.txt,temps.txt,dump_T.start.txt,dump_T.end.txt,summary.json} "$out"/dump_classes.*
 cp "$case_file" "$out/case.toml"
 python3 "$here/deck_from_case.py" "$out/case.toml" "$out" "${@:3}"
 cd "$out"
