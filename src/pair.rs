@@ -124,8 +124,13 @@ fn as_json(p: &Paired) -> Result<serde_json::Value> {
 fn tell(p: &Paired, what: &str) {
     let s = &p.measured;
     let cycles = pairing::cycle_structure(&p.stored.g);
+    // a bed of several sizes is paired one size class at a time
+    let classes = match s.size_classes {
+        Some(k) if k > 1 => format!(" within {k} size classes"),
+        _ => String::new(),
+    };
     println!(
-        "{what:<13} {} particles, total distance {} diameters (mean {}), k = {}, {} solve round(s), {}",
+        "{what:<13} {} particles{classes}, total distance {} diameters (mean {}), k = {}, {} solve round(s), {}",
         s.particles,
         crate::fmt::sig(s.total_distance_diameters, 4),
         crate::fmt::sig(s.mean_distance_diameters, 4),

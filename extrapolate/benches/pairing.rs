@@ -20,6 +20,15 @@
 //!   lattice orientation and offset, other jitter): no correlation at all, the worst case;
 //! * `circulation`: t0 carried by a smooth incompressible circulation confined to the bed
 //!   (up to 3 diameters) plus 1 diameter of random jitter.
+//!
+//! and `sizes`: a circulation of the same t0 (its own draw) on a bed of three size classes
+//! (radii 1, 1.25 and 1.5 times d/2 in number fractions 0.3, 0.4 and 0.3, dealt to the
+//! particles at random from a fixed seed, each particle keeping its radius at t1), paired
+//! within the classes (`pair_by_size`) and, alternately in the same run, as one size
+//! (`pair`) on the same positions; `TDEX_REPEAT` (default 3) pairs of runs.
+//!
+//! A filter after `--` runs only the cases whose name contains it:
+//! `cargo bench -p extrapolate --bench pairing -- sizes`.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -27,7 +36,7 @@ mod common;
 use std::time::Instant;
 
 use common::{circulation, fill_fraction, is_permutation, packing, surface_height, Drum, Rng};
-use extrapolate::pairing::{pair, Pairing, PairingOptions};
+use extrapolate::pairing::{pair, pair_by_size, Pairing, PairingOptions};
 
 const D: f64 = 0.01;
 
@@ -170,7 +179,87 @@ fn recording(path: &str, threads: usize) {
     println!("min {min:.3} s, range {min:.3}–{max:.3} s over {repeat} runs");
 }
 
+/// Three size classes on the circulation of `x0`: the pairing within them beside the pairing
+/// of the same positions as one size, alternated `repeat` times on the same pool.
+fn sizes(drum: &Drum, x0: &[[f64; 3]], h: f64, pool: &rayon::ThreadPool, k: usize) {
+    let n = x0.len();
+    // The circulation shuffles its output. Its draws do not depend on the points, nor its
+    // flow across the axis on the axial coordinate, so the same draw on t0 with each axial
+    // coordinate replaced by 1 000 m times the index moves every point alike and tells
+    // which t0 particle each t1 point is (the axial drift and jitter stay below 0.1 m).
+    let seed = 20261206;
+    let x1 = circulation(drum, x0, h, 3.0 * D, 1.0 * D, &mut Rng::new(seed));
+    let tagged: Vec<[f64; 3]> = x0
+        .iter()
+        .enumerate()
+        .map(|(i, p)| [p[0], p[1], i as f64 * 1e3])
+        .collect();
+    let source: Vec<usize> = circulation(drum, &tagged, h, 3.0 * D, 1.0 * D, &mut Rng::new(seed))
+        .iter()
+        .map(|p| (p[2] / 1e3).round() as usize)
+        .collect();
+    let base = 0.5 * D;
+    let (small, middle) = (n * 3 / 10, n * 4 / 10);
+    let mut r0: Vec<f64> = (0..n)
+        .map(|i| {
+            base * if i < small {
+                1.0
+            } else if i < small + middle {
+                1.25
+            } else {
+                1.5
+            }
+        })
+        .collect();
+    Rng::new(seed + 1).shuffle(&mut r0);
+    let r1: Vec<f64> = source.iter().map(|&i| r0[i]).collect();
+    let d = 2.0 * r0.iter().sum::<f64>() / n as f64;
+    let defaults = PairingOptions::for_bed(d, x0, &x1);
+    let opts = PairingOptions {
+        k_initial: k,
+        ..defaults
+    };
+    println!(
+        "sizes: {small} of radius {base} m, {middle} of {}, {} of {}; mean diameter {d:.5} m, \
+         unit {:.3e} m",
+        1.25 * base,
+        n - small - middle,
+        1.5 * base,
+        opts.unit
+    );
+    let repeat = env_usize("TDEX_REPEAT", 3);
+    let (mut one_size, mut classes) = (Vec::new(), Vec::new());
+    for i in 0..repeat {
+        let single = pool.install(|| pair(x0, &x1, &opts)).unwrap();
+        assert!(is_permutation(&single.g));
+        report_d(&format!("one size#{i}"), &single, D);
+        let sized = pool
+            .install(|| pair_by_size(x0, &r0, &x1, &r1, &opts))
+            .unwrap();
+        assert!(is_permutation(&sized.g));
+        assert!(sized
+            .g
+            .iter()
+            .enumerate()
+            .all(|(p, &q)| r0[q as usize] == r1[p]));
+        report_d(&format!("3 sizes#{i}"), &sized, D);
+        one_size.push(single.seconds);
+        classes.push(sized.seconds);
+    }
+    let range = |t: &[f64]| {
+        (
+            t.iter().copied().fold(f64::INFINITY, f64::min),
+            t.iter().copied().fold(0.0, f64::max),
+        )
+    };
+    let ((a, b), (c, e)) = (range(&one_size), range(&classes));
+    println!("one size {a:.3}–{b:.3} s, three sizes {c:.3}–{e:.3} s over {repeat} alternated runs");
+}
+
 fn main() {
+    // `cargo bench` passes `--bench`; a word without a dash selects the cases
+    let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let wanted = |name: &str| filter.as_deref().is_none_or(|f| name.contains(f));
     let threads = env_usize("TDEX_THREADS", 2);
     if let Ok(path) = std::env::var("TDEX_RECORDING") {
         recording(&path, threads);
@@ -215,6 +304,9 @@ fn main() {
         ..defaults
     };
     for (name, x1) in [("independent", &independent), ("circulation", &circ)] {
+        if !wanted(name) {
+            continue;
+        }
         let r = pool.install(|| pair(&x0, x1, &opts)).unwrap();
         assert!(is_permutation(&r.g));
         report(name, &r);
@@ -235,5 +327,8 @@ fn main() {
         report(&format!("{name}/1thr"), &s);
         assert_eq!(s.g, r.g, "result depends on the thread count");
         assert_eq!(s.total_cost, r.total_cost);
+    }
+    if wanted("sizes") {
+        sizes(&drum, &x0, h, &pool, opts.k_initial);
     }
 }

@@ -284,8 +284,9 @@ pub fn fresh_pool(
             Redraw::Steps(cells) => step_ends(before, end, cells, &mut rng),
             Redraw::Drift(drift) => drift.moved_ends(end, &mut rng),
         };
+        // the moved ends are `end`'s particles: each keeps its radius, and its role's
         let opts = PairingOptions::for_bed(d, &start.pos, &ends);
-        let p = pairing::pair(&start.pos, &ends, &opts)?;
+        let p = pairing::pair_by_size(&start.pos, &start.radius, &ends, &end.radius, &opts)?;
         means.push(p.mean_distance_in_diameters(d));
         pairings.push(p.g);
     }

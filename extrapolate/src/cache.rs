@@ -42,11 +42,14 @@ pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
 
 /// Computes the pairing of the snapshot `t1` (the end of a period) to `t0` (the start of
 /// one) on the current worker pool: `g[p]` is the role at `t0` nearest particle `p` at
-/// `t1`. Its summary carries the solve's time and thread count.
+/// `t1` among those of its own radius ([`pairing::pair_by_size`], one cost unit for the
+/// whole bed). Its summary carries the solve's time and thread count, and the number of
+/// size classes when there are several.
 pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, ExtrapolateError> {
     let d = t0.mean_diameter();
     let opts = PairingOptions::for_bed(d, &t0.pos, &t1.pos);
-    let p = pairing::pair(&t0.pos, &t1.pos, &opts)?;
+    let p = pairing::pair_by_size(&t0.pos, &t0.radius, &t1.pos, &t1.radius, &opts)?;
+    let classes = pairing::class_radii(&t0.radius).len();
     Ok(StoredPairing {
         snapshots_fingerprint: fingerprint(t0, t1),
         summary: PairingSummary {
@@ -57,6 +60,7 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, Extrapolat
             k_used: p.k_used,
             certified: p.certified,
             rounds: p.rounds,
+            size_classes: (classes > 1).then_some(classes),
             seconds: Some(p.seconds),
             threads: Some(rayon::current_num_threads()),
         },
@@ -97,6 +101,11 @@ fn sidecar_path(reader: &RecordingReader, end: u32, start: u32, symmetry: Symmet
 
 /// [`load`] of the pairing of `t1` (end) to `start`, the image under `symmetry` of a
 /// recorded start ([`start_image`]): its sidecar is named by the symmetry as well.
+///
+/// On a bed of several particle sizes a stored pairing is reused only if it was computed
+/// with its size classes: its summary counts as many as the snapshots hold, and it maps
+/// every particle onto a role of its own radius. One written before sizes were kept apart
+/// is stale and computed again.
 pub fn load_image(
     reader: &RecordingReader,
     start: &Snapshot,
@@ -106,7 +115,11 @@ pub fn load_image(
     let n = reader.info().particles as usize;
     let path = sidecar_path(reader, t1.index, start.index, symmetry);
     let stored = sidecar::read(&path, n).ok()??;
-    (stored.snapshots_fingerprint == fingerprint(start, t1)).then_some(stored)
+    let classes = pairing::class_radii(&t1.radius).len();
+    let fresh = stored.snapshots_fingerprint == fingerprint(start, t1)
+        && stored.summary.size_classes.unwrap_or(1) == classes
+        && pairing::respects_classes(&stored.g, &start.radius, &t1.radius);
+    fresh.then_some(stored)
 }
 
 /// Writes the pairing of snapshot `end` to snapshot `start` beside the recording

@@ -16,13 +16,18 @@
 //!   optimality certificate against every excluded pair, through the dual potentials
 //!   (pairs it finds are added and the solve repeated, warm-started, until it holds).
 //!
+//! * [`pair_by_size`] — [`pair`] on each size class of a bed of several particle sizes, so
+//!   that a particle only takes the role of one of its own radius.
+//!
 //! Module map: `cost` (integer objective), `order` (Morton renumbering), `candidates`
 //! (kNN graph), `sparse_lap` (the solver), `feasibility` (Hopcroft–Karp, exit edges),
-//! `certificate` (weighted k-d tree search), `dense` (the oracle). The method and its
+//! `certificate` (weighted k-d tree search), `dense` (the oracle), `classes` (size
+//! classes). The method and its
 //! soundness argument are written up in `docs/pairing.md`.
 
 mod candidates;
 mod certificate;
+mod classes;
 mod cost;
 pub mod cycles;
 mod dense;
@@ -33,6 +38,7 @@ mod sparse_lap;
 
 use std::time::Instant;
 
+pub use classes::{class_radii, pair_by_size, respects_classes};
 pub use cycles::{cycle_structure, CycleStructure, SHORT_CYCLE};
 pub use dense::DENSE_LIMIT;
 
@@ -173,6 +179,20 @@ pub enum PairingError {
     /// The dense oracle was asked for more than [`DENSE_LIMIT`] particles.
     #[error("the dense oracle takes at most {max} particles, got {n}; use `pair`")]
     TooLargeForDense { n: usize, max: usize },
+    /// A snapshot does not hold one radius per position ([`pair_by_size`]).
+    #[error("the {snapshot} snapshot has {radii} radii for {positions} positions")]
+    RadiusCount {
+        snapshot: &'static str,
+        radii: usize,
+        positions: usize,
+    },
+    /// A size class has not as many particles at t0 as at t1 ([`pair_by_size`]): no
+    /// bijection keeps every particle in its class.
+    #[error(
+        "particles of radius {radius}: {n0} at t0, {n1} at t1; a particle can only take the \
+         role of one of its own radius"
+    )]
+    ClassMismatch { radius: f64, n0: usize, n1: usize },
 }
 
 /// Checks sizes and coordinates; returns n.

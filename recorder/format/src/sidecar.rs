@@ -16,6 +16,12 @@ pub struct PairingSummary {
     pub k_used: usize,
     pub certified: bool,
     pub rounds: u32,
+    /// Particle size classes (distinct radii) paired apart, a particle only taking the role
+    /// of one of its own radius; absent for a bed of one size, where the whole bed is one
+    /// class (and in sidecars written before sizes were kept apart, which a bed of several
+    /// sizes therefore does not reuse).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub size_classes: Option<usize>,
     /// Wall time and worker threads of the solve; left out of a reproducible pairing
     /// (`tdex pair --reproducible`), the only fields that depend on the machine.
     #[serde(default, skip_serializing_if = "Option::is_none")]
