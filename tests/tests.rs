@@ -19,6 +19,7 @@ mod cli_record;
 mod cli_recorded_periods;
 mod cli_report;
 mod cli_run;
+mod cli_sizes;
 mod cli_study;
 mod drum;
 mod fuzz_corpus;
