@@ -132,12 +132,10 @@ fn a_pair_crossing_the_seam_while_touching_keeps_its_contact_and_conserves_momen
     assert!(((crossed.heat - heat0) / heat0).abs() < 1e-12);
     let momentum0 =
         [0, 1, 2].map(|k| start.mass[0] * start.vel[0][k] + start.mass[1] * start.vel[1][k]);
-    for k in 0..3 {
+    for (k, (after, before)) in crossed.momentum.iter().zip(momentum0).enumerate() {
         assert!(
-            (crossed.momentum[k] - momentum0[k]).abs() < 1e-12 * mass_scale,
-            "momentum {k}: {} → {}",
-            momentum0[k],
-            crossed.momentum[k]
+            (after - before).abs() < 1e-12 * mass_scale,
+            "momentum {k}: {before} → {after}"
         );
     }
 }
