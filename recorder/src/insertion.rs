@@ -99,9 +99,8 @@ pub(crate) fn uniform(rng: &mut Xoshiro256PlusPlus) -> f64 {
 }
 
 /// Largest share of the drum's volume the spheres of several sizes may fill at insertion:
-/// random sequential
-/// placement jams near 0.38 for equal spheres and higher for mixed ones, so 0.30 is
-/// reached in a few attempts per sphere.
+/// random sequential placement jams near 0.38 for equal spheres and higher for mixed ones,
+/// so 0.30 is reached in a few attempts per sphere.
 pub const MAX_RANDOM_FILL: f64 = 0.30;
 /// Attempts per sphere before random placement gives up.
 const ATTEMPTS: usize = 100_000;
