@@ -94,7 +94,8 @@ fn pair(
     symmetry: Symmetry,
 ) -> Result<Paired> {
     let image = start_image(start, symmetry);
-    let mut stored = crate::with_workers(plan.threads, || Ok(compute(&image, end)?))?;
+    let period = extrapolate::axial_period(reader.info());
+    let mut stored = crate::with_workers(plan.threads, || Ok(compute(&image, end, period)?))?;
     let measured = stored.summary.clone();
     if plan.reproducible {
         stored.summary = stored.summary.reproducible();

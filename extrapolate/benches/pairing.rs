@@ -27,6 +27,13 @@
 //! within the classes (`pair_by_size`) and, alternately in the same run, as one size
 //! (`pair`) on the same positions; `TDEX_REPEAT` (default 3) pairs of runs.
 //!
+//! and `periodic`: the same t0 as a section periodic along its axis (the axis turned to y,
+//! the period the drum's length), t1 the `circulation` draw carried 2 diameters along the
+//! axis, so that the particles near one end cross the seam; paired across the seam
+//! (`axial_period`, t1 wrapped into the section) and, alternately in the same run, without
+//! a period on the same t1 left unwrapped (the same displacements, no seam);
+//! `TDEX_REPEAT` (default 3) pairs of runs.
+//!
 //! A filter after `--` runs only the cases whose name contains it:
 //! `cargo bench -p extrapolate --bench pairing -- sizes`.
 
@@ -256,6 +263,66 @@ fn sizes(drum: &Drum, x0: &[[f64; 3]], h: f64, pool: &rayon::ThreadPool, k: usiz
     println!("one size {a:.3}–{b:.3} s, three sizes {c:.3}–{e:.3} s over {repeat} alternated runs");
 }
 
+/// The `periodic` case (module documentation): the bed as a periodic section, paired across
+/// the seam, beside the same displacements paired without a seam.
+fn periodic(
+    drum: &Drum,
+    x0: &[[f64; 3]],
+    circ: &[[f64; 3]],
+    pool: &rayon::ThreadPool,
+    k_initial: usize,
+) {
+    let repeat = env_usize("TDEX_REPEAT", 3);
+    let length = drum.length;
+    // the drum's axis (z from 0 to `length`) turned to y, centred on the origin
+    let section = |p: &[f64; 3], shift: f64| [p[0], p[2] - 0.5 * length + shift, p[1]];
+    let wrap = |[x, y, z]: [f64; 3]| {
+        let y = if y >= 0.5 * length {
+            y - length
+        } else if y < -0.5 * length {
+            y + length
+        } else {
+            y
+        };
+        [x, y, z]
+    };
+    let s0: Vec<[f64; 3]> = x0.iter().map(|p| section(p, 0.0)).collect();
+    let carried: Vec<[f64; 3]> = circ.iter().map(|p| section(p, 2.0 * D)).collect();
+    let wrapped: Vec<[f64; 3]> = carried.iter().copied().map(wrap).collect();
+    let crossed = carried
+        .iter()
+        .zip(&wrapped)
+        .filter(|(a, b)| a[1] != b[1])
+        .count();
+    let plain = PairingOptions {
+        k_initial,
+        ..PairingOptions::for_diameter(D)
+    };
+    let across = PairingOptions {
+        axial_period: Some(length),
+        ..plain.clone()
+    };
+    println!("periodic: period {length} m, {crossed} particles crossed the seam");
+    let (mut without, mut with) = (Vec::new(), Vec::new());
+    for i in 0..repeat {
+        let a = pool.install(|| pair(&s0, &carried, &plain)).unwrap();
+        report(&format!("no seam#{i}"), &a);
+        let b = pool.install(|| pair(&s0, &wrapped, &across)).unwrap();
+        assert!(is_permutation(&b.g) && b.certified);
+        report(&format!("periodic#{i}"), &b);
+        without.push(a.seconds);
+        with.push(b.seconds);
+    }
+    let range = |t: &[f64]| {
+        (
+            t.iter().copied().fold(f64::INFINITY, f64::min),
+            t.iter().copied().fold(0.0, f64::max),
+        )
+    };
+    let ((a, b), (c, e)) = (range(&without), range(&with));
+    println!("no seam {a:.3}–{b:.3} s, periodic {c:.3}–{e:.3} s over {repeat} alternated runs");
+}
+
 fn main() {
     // `cargo bench` passes `--bench`; a word without a dash selects the cases
     let filter = std::env::args().skip(1).find(|a| !a.starts_with('-'));
@@ -330,5 +397,8 @@ fn main() {
     }
     if wanted("sizes") {
         sizes(&drum, &x0, h, &pool, opts.k_initial);
+    }
+    if wanted("periodic") {
+        periodic(&drum, &x0, &circ, &pool, opts.k_initial);
     }
 }

@@ -52,7 +52,8 @@ fn pair(recording: &Path, end: u32, start: u32) -> Result<(), String> {
         cache::snapshot(&reader, end).map_err(named)?,
         cache::snapshot(&reader, start).map_err(named)?,
     );
-    let stored = cache::compute(&t_start, &t_end).map_err(named)?;
+    let period = extrapolate::axial_period(reader.info());
+    let stored = cache::compute(&t_start, &t_end, period).map_err(named)?;
     let path = cache::store(&reader, end, start, &stored).map_err(named)?;
     let s = &stored.summary;
     println!(

@@ -43,11 +43,20 @@ pub fn fingerprint(t0: &Snapshot, t1: &Snapshot) -> u64 {
 /// Computes the pairing of the snapshot `t1` (the end of a period) to `t0` (the start of
 /// one) on the current worker pool: `g[p]` is the role at `t0` nearest particle `p` at
 /// `t1` among those of its own radius ([`pairing::pair_by_size`], one cost unit for the
-/// whole bed). Its summary carries the solve's time and thread count, and the number of
-/// size classes when there are several.
-pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, ExtrapolateError> {
+/// whole bed), the distances taken across the seam of a section periodic along its axis
+/// with period `axial_period` ([`crate::axial_period`] of the recording). Its summary
+/// carries the solve's time and thread count, the number of size classes when there are
+/// several, and the period when there is one.
+pub fn compute(
+    t0: &Snapshot,
+    t1: &Snapshot,
+    axial_period: Option<f64>,
+) -> Result<StoredPairing, ExtrapolateError> {
     let d = t0.mean_diameter();
-    let opts = PairingOptions::for_bed(d, &t0.pos, &t1.pos);
+    let opts = PairingOptions {
+        axial_period,
+        ..PairingOptions::for_bed(d, &t0.pos, &t1.pos)
+    };
     let p = pairing::pair_by_size(&t0.pos, &t0.radius, &t1.pos, &t1.radius, &opts)?;
     let classes = pairing::class_radii(&t0.radius).len();
     Ok(StoredPairing {
@@ -61,6 +70,7 @@ pub fn compute(t0: &Snapshot, t1: &Snapshot) -> Result<StoredPairing, Extrapolat
             certified: p.certified,
             rounds: p.rounds,
             size_classes: (classes > 1).then_some(classes),
+            axial_period,
             seconds: Some(p.seconds),
             threads: Some(rayon::current_num_threads()),
         },
@@ -105,7 +115,9 @@ fn sidecar_path(reader: &RecordingReader, end: u32, start: u32, symmetry: Symmet
 /// On a bed of several particle sizes a stored pairing is reused only if it was computed
 /// with its size classes: its summary counts as many as the snapshots hold, and it maps
 /// every particle onto a role of its own radius. One written before sizes were kept apart
-/// is stale and computed again.
+/// is stale and computed again. Likewise a stored pairing is reused only if it was
+/// computed with the recording's axial period ([`crate::axial_period`]): for a periodic
+/// section, one computed without the seam is stale.
 pub fn load_image(
     reader: &RecordingReader,
     start: &Snapshot,
@@ -118,7 +130,9 @@ pub fn load_image(
     let classes = pairing::class_radii(&t1.radius).len();
     let fresh = stored.snapshots_fingerprint == fingerprint(start, t1)
         && stored.summary.size_classes.unwrap_or(1) == classes
-        && pairing::respects_classes(&stored.g, &start.radius, &t1.radius);
+        && pairing::respects_classes(&stored.g, &start.radius, &t1.radius)
+        && stored.summary.axial_period.map(f64::to_bits)
+            == crate::axial_period(reader.info()).map(f64::to_bits);
     fresh.then_some(stored)
 }
 

@@ -13,8 +13,8 @@ pub mod path;
 pub mod replay;
 
 pub use driver::{
-    extrapolate_recording, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest,
-    MemoryLimit, MirrorCheck, Notice, TableChoice,
+    axial_period, extrapolate_recording, has_mirror_image, ExtrapolationOutcome,
+    ExtrapolationRequest, MemoryLimit, MirrorCheck, Notice, TableChoice,
 };
 pub use error::{fault_of, ExtrapolateError};
 /// The pairing sidecar's format lives with the other files in `tdex-format`.

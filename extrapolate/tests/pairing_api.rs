@@ -36,7 +36,7 @@ proptest! {
     /// k and however degenerate the points (duplicates, ties, n = 1).
     #[test]
     fn pair_is_an_optimal_permutation((x0, x1) in snapshots(), k in 1usize..5) {
-        let opts = PairingOptions { unit: 1e-6, k_initial: k, dense_max: 0, certify: true };
+        let opts = PairingOptions { unit: 1e-6, k_initial: k, dense_max: 0, certify: true, axial_period: None };
         let s = pair(&x0, &x1, &opts).unwrap();
         prop_assert!(is_permutation(&s.g));
         prop_assert_eq!(s.g.len(), x0.len());
@@ -50,7 +50,7 @@ proptest! {
     /// candidate graph only, so no claim on the total beyond the oracle's bound).
     #[test]
     fn uncertified_is_a_permutation((x0, x1) in snapshots(), k in 1usize..5) {
-        let opts = PairingOptions { unit: 1e-6, k_initial: k, dense_max: 0, certify: false };
+        let opts = PairingOptions { unit: 1e-6, k_initial: k, dense_max: 0, certify: false, axial_period: None };
         let s = pair(&x0, &x1, &opts).unwrap();
         prop_assert!(is_permutation(&s.g));
         prop_assert!(!s.certified);

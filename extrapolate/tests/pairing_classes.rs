@@ -343,7 +343,7 @@ fn a_sidecar_that_ignored_the_sizes_is_stale_and_the_extrapolation_keeps_the_hea
     let (t0, t1) = write_recording(&rec);
     let reader = RecordingReader::open(&rec).unwrap();
 
-    let stored = cache::compute(&t0, &t1).unwrap();
+    let stored = cache::compute(&t0, &t1, None).unwrap();
     assert_eq!(stored.summary.size_classes, Some(2));
     assert!(respects_classes(&stored.g, &t0.radius, &t1.radius));
     let free = pair(
@@ -407,7 +407,7 @@ fn a_bed_of_one_size_stores_no_class_count() {
     let (mut t0, mut t1) = (snapshot(0, &mut rng), snapshot(1, &mut rng));
     t0.radius = vec![0.005; N];
     t1.radius = vec![0.005; N];
-    let stored = cache::compute(&t0, &t1).unwrap();
+    let stored = cache::compute(&t0, &t1, None).unwrap();
     assert_eq!(stored.summary.size_classes, None);
     let json = serde_json::to_string(&stored.summary).unwrap();
     assert!(!json.contains("size_classes"), "{json}");

@@ -458,8 +458,8 @@ fn the_axial_mirror_alternates_the_images_through_the_pairing_of_t1_with_the_mir
     let (t0, t1) = (&syn.snapshots[0], &syn.snapshots[1]);
     let image = extrapolate::cache::start_image(t0, Symmetry::AxialMirror);
     assert_eq!(image.pos, mirror(&t0.pos));
-    let mirrored = extrapolate::cache::compute(&image, t1).unwrap();
-    let plain = extrapolate::cache::compute(t0, t1).unwrap();
+    let mirrored = extrapolate::cache::compute(&image, t1, None).unwrap();
+    let plain = extrapolate::cache::compute(t0, t1, None).unwrap();
     let g = mirrored.g.clone();
     let check = extrapolate::MirrorCheck {
         end: 1,

@@ -153,3 +153,13 @@ pub fn has_mirror_image(info: &RecordingInfo) -> bool {
         .get("drum")
         .is_some_and(serde_json::Value::is_object)
 }
+
+/// The period along the axis (the drum's `length`) when the recording's drum is a section
+/// periodic along it (`[drum] end_caps = "periodic"`), else `None`: the pairings of such a
+/// recording take their distances across the seam.
+pub fn axial_period(info: &RecordingInfo) -> Option<f64> {
+    let drum = info.case_resolved.get("drum")?;
+    (drum.get("end_caps")?.as_str()? == "periodic")
+        .then(|| drum.get("length")?.as_f64())
+        .flatten()
+}

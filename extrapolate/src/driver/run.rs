@@ -3,7 +3,8 @@
 //! plan, the pairings, the tables, the replay written out, the outcome.
 
 use super::{
-    has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck, Notice, TableChoice,
+    axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck,
+    Notice, TableChoice,
 };
 use crate::boundary::{self, BoundaryMaps, Pool, PoolDraws};
 use crate::cache;
@@ -108,6 +109,13 @@ impl<'a> Extrapolation<'a> {
         if request.boundary != BoundaryMaps::Exact && !has_mirror_image(&info) {
             return Err(ExtrapolateError::NoDrumAxis {
                 recording: request.recording.clone(),
+            });
+        }
+        if let (true, Some(period)) = (request.boundary != BoundaryMaps::Exact, axial_period(&info))
+        {
+            return Err(ExtrapolateError::FreshMapsOfPeriodicSection {
+                recording: request.recording.clone(),
+                period,
             });
         }
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
@@ -287,7 +295,7 @@ impl<'a> Extrapolation<'a> {
         let started = Instant::now();
         let start = start_image(&self.snaps, period, symmetry);
         let end = self.end();
-        let mut stored = cache::compute(&start, end)?;
+        let mut stored = cache::compute(&start, end, axial_period(&self.info))?;
         if self.request.reproducible {
             stored.summary = stored.summary.reproducible();
         }

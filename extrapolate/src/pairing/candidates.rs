@@ -41,9 +41,20 @@ pub(crate) struct Grid {
     start: Vec<u32>,
     pts: Vec<[f64; 3]>,
     idx: Vec<u32>,
+    /// On a periodic section, the t0 index of each point ([`Images::of`]): the grid then
+    /// holds the images, and only [`knn_images`] queries it.
+    images: Option<Vec<u32>>,
 }
 
 impl Grid {
+    /// The grid of a periodic section's t0 points and their images ([`Images`]).
+    pub(crate) fn with_images(images: &Images) -> Self {
+        Self {
+            images: Some(images.of.clone()),
+            ..Self::new(&images.pts)
+        }
+    }
+
     pub(crate) fn new(x0: &[[f64; 3]]) -> Self {
         let (lo, hi) = super::order::bounds(x0, &[]);
         let extent: [f64; 3] = std::array::from_fn(|a| (hi[a] - lo[a]).max(0.0));
@@ -89,6 +100,7 @@ impl Grid {
             start: vec![0; cells + 1],
             pts: Vec::with_capacity(x0.len()),
             idx: Vec::with_capacity(x0.len()),
+            images: None,
         };
         let of: Vec<u32> = x0.iter().map(|p| grid.cell_of(p) as u32).collect();
         for &c in &of {
@@ -406,6 +418,77 @@ pub(crate) fn knn(
     (cols, costs)
 }
 
+/// The t0 points of a periodic section and their images one period away along y on
+/// either side: the points the candidate search and the certificate's radius queries run
+/// on. `of[t]` is the t0 index of point `t` (images carry their original's index, and
+/// hence its potential).
+///
+/// With every position in `[−L/2, L/2]`, `|Δy| <= L` for every pair, so the nearest image
+/// of `x0[q]` seen from any t1 point is `x0[q]` shifted by `−L`, 0 or `+L`: every pair's
+/// periodic distance is the Euclidean distance to one of these points (up to the rounding
+/// of `y ± L`, a few ulps of `L`, far below the one cost unit of slack the certificate
+/// keeps). The periodic distance is the minimum over the images, so no image is nearer.
+pub(crate) struct Images {
+    pub(crate) pts: Vec<[f64; 3]>,
+    pub(crate) of: Vec<u32>,
+}
+
+impl Images {
+    /// `x0`, then `x0` shifted by `+period` along y, then by `−period`.
+    pub(crate) fn of(x0: &[[f64; 3]], period: f64) -> Self {
+        let n = x0.len();
+        let mut pts = Vec::with_capacity(3 * n);
+        pts.extend_from_slice(x0);
+        for shift in [period, -period] {
+            pts.extend(x0.iter().map(|&[x, y, z]| [x, y + shift, z]));
+        }
+        let of = (0..3).flat_map(|_| 0..n as u32).collect();
+        Self { pts, of }
+    }
+}
+
+/// [`knn`] on a periodic section: the k nearest of `grid`'s points (built by
+/// [`Grid::with_images`]) to every query centre, each taken to its t0 index `images[t]` and
+/// costed with the periodic distance from the t0 point itself, so that an edge costs the
+/// same whichever image found it. Two images of one t0 point can both be among a row's k
+/// nearest (a section a few k-th neighbour distances long): the row keeps the column once
+/// (its cost is the same), so rows hold at most k edges. Rows sorted by (cost, column).
+pub(crate) fn knn_images(
+    grid: &Grid,
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    centres: &[[f64; 3]],
+    k: usize,
+    scale: &CostScale,
+) -> Graph {
+    let images: &[u32] = grid.images.as_deref().unwrap_or(&[]);
+    let k = k.clamp(1, images.len());
+    let radius2 = grid.block_radius2(k);
+    let rows: Vec<Vec<(EdgeCost, u32)>> = (0..x1.len())
+        .into_par_iter()
+        .with_min_len(256)
+        .map_init(
+            || (Vec::with_capacity(2 * k), Block::new()),
+            |(found, block), p| {
+                if !grid.nearest_in_block(&centres[p], k, radius2, block, found) {
+                    grid.nearest(&centres[p], k, found);
+                }
+                let mut row: Vec<(EdgeCost, u32)> = found
+                    .iter()
+                    .map(|&(_, t)| {
+                        let q = images[t as usize];
+                        (scale.edge_cost(&x1[p], &x0[q as usize]), q)
+                    })
+                    .collect();
+                row.sort_unstable();
+                row.dedup();
+                row
+            },
+        )
+        .collect();
+    Graph::from_rows(&rows)
+}
+
 /// Mean cost of the cheapest of the k candidates of every `stride`-th row (rows 0,
 /// stride, 2·stride, …): the mean cheapest candidate cost of the k-graph, estimated from a
 /// fixed sample of its rows without building the graph. With `stride = 1` it is exactly
@@ -425,6 +508,14 @@ pub(crate) fn mean_cheapest_sampled(
         .step_by(stride.max(1))
         .map(|(p, c)| (*p, *c))
         .unzip();
+    if grid.images.is_some() {
+        let graph = knn_images(grid, x0, &rows, &row_centres, k, scale);
+        // Each row's entries are sorted by cost: the first is its cheapest.
+        let sum: u64 = (0..graph.rows())
+            .map(|p| u64::from(graph.row(p).1[0]))
+            .sum();
+        return sum as f64 / rows.len().max(1) as f64;
+    }
     let k = k.clamp(1, x0.len());
     let (_, costs) = knn(grid, x0, &rows, &row_centres, k, scale);
     // Each row's entries are sorted by cost: the first is its cheapest.
@@ -582,6 +673,28 @@ impl Graph {
             offsets: (0..=rows).map(|p| p * k).collect(),
             cols: knn_cols,
             costs: knn_costs,
+            spare_cols: Vec::new(),
+            spare_costs: Vec::new(),
+        }
+    }
+
+    /// The graph of rows of (cost, column) edges, each row in the order given.
+    pub(crate) fn from_rows(rows: &[Vec<(EdgeCost, u32)>]) -> Self {
+        let mut offsets = Vec::with_capacity(rows.len() + 1);
+        offsets.push(0);
+        let total: usize = rows.iter().map(Vec::len).sum();
+        let (mut cols, mut costs) = (Vec::with_capacity(total), Vec::with_capacity(total));
+        for row in rows {
+            for &(c, q) in row {
+                costs.push(c);
+                cols.push(q);
+            }
+            offsets.push(cols.len());
+        }
+        Self {
+            offsets,
+            cols,
+            costs,
             spare_cols: Vec::new(),
             spare_costs: Vec::new(),
         }

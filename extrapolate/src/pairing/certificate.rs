@@ -25,7 +25,7 @@
 
 use rayon::prelude::*;
 
-use super::candidates::Graph;
+use super::candidates::{Graph, Images};
 use super::cost::CostScale;
 use super::sparse_lap::Lap;
 
@@ -94,6 +94,9 @@ pub(crate) struct WeightedTree {
     idx: Vec<u32>,
     /// Weights in tree order.
     w: Vec<f64>,
+    /// The tree holds a periodic section's images ([`WeightedTree::with_images`]): a pair
+    /// is then costed from the t0 point itself, not from the image that found it.
+    images: bool,
 }
 
 impl WeightedTree {
@@ -123,7 +126,22 @@ impl WeightedTree {
             axes,
             idx,
             w: vec![0.0; x0.len()],
+            images: false,
         }
+    }
+
+    /// The tree of a periodic section's t0 points and their images one period away on
+    /// either side ([`Images`]), each image carrying its original's index and so its weight.
+    /// A radius query then reaches every image of every t0 point, and among them the
+    /// nearest, whose distance is the pair's periodic distance: every violator of the
+    /// periodic problem is found (docs/pairing.md#periodic-sections).
+    pub(crate) fn with_images(images: &Images) -> Self {
+        let mut tree = Self::new(&images.pts);
+        for i in &mut tree.idx {
+            *i = images.of[*i as usize];
+        }
+        tree.images = true;
+        tree
     }
 
     /// Loads `W_q = (v_max − v(q)) · unit` and recomputes the node minima.
@@ -331,6 +349,8 @@ struct RowCheck {
 /// sorted by column, and the reduced cost of the first pair left out, if any.
 fn tightest(mut pairs: Vec<(i64, u32)>, limit: usize) -> (Vec<u32>, Option<i64>) {
     pairs.sort_unstable();
+    // Two images of one t0 point found by the same row give the same pair twice.
+    pairs.dedup();
     let left_out = pairs.get(limit).map(|&(reduced, _)| reduced);
     pairs.truncate(limit);
     let mut cols: Vec<u32> = pairs.into_iter().map(|(_, q)| q).collect();
@@ -392,6 +412,7 @@ impl Memo {
 /// [`Memo::new`]); rows that cannot have gained a violation since are skipped.
 pub(crate) fn check(
     tree: &mut WeightedTree,
+    x0: &[[f64; 3]],
     x1: &[[f64; 3]],
     lap: &Lap,
     graph: &Graph,
@@ -439,7 +460,12 @@ pub(crate) fn check(
             tree.search(&x1[p], r, stack, |t| {
                 examined += 1;
                 let q = tree.idx[t];
-                let reduced = scale.cost(&x1[p], &tree.point(t)) - u - lap.v(q as usize);
+                let at_t0 = if tree.images {
+                    x0[q as usize]
+                } else {
+                    tree.point(t)
+                };
+                let reduced = scale.cost(&x1[p], &at_t0) - u - lap.v(q as usize);
                 if reduced < 0 {
                     bad.push((reduced, q));
                 } else if reduced < slack && !edges.contains(&q) {
@@ -515,7 +541,7 @@ mod tests {
         // A slack of 0.3 (a few point spacings): dozens of close columns per row.
         let per_row = 2;
         let mut memo = Memo::new((0.3 / unit) as i64, per_row);
-        let check = check(&mut tree, &x1, &lap, &graph, &scale, &mut memo);
+        let check = check(&mut tree, &x0, &x1, &lap, &graph, &scale, &mut memo);
         assert!(!check.close.is_empty());
         let mut returned = vec![Vec::new(); n];
         for &(p, q) in check.violations.iter().chain(&check.close) {

@@ -160,7 +160,7 @@ pub fn pair_by_size(
         merged.certificate_examined += class.certificate_examined;
         merged.auction_bids += class.auction_bids;
     }
-    merged.total_distance = total_distance(x0, x1, &g);
+    merged.total_distance = total_distance(x0, x1, &g, opts.axial_period);
     merged.g = g;
     merged.seconds = start.elapsed().as_secs_f64();
     Ok(merged)

@@ -36,6 +36,30 @@ pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     (dx * dx + dy * dy + dz * dz).sqrt()
 }
 
+/// Distance across a section periodic along y with period `length`: the y part of `b − a`
+/// taken to its nearest image, `Δy − length · round(Δy / length)` (the formula of the DEM
+/// engine's seam), then the Euclidean norm. Every periodic cost is computed by this one
+/// function, so the sparse solver and the dense oracle agree on every integer.
+#[inline]
+pub(crate) fn periodic_distance(a: &[f64; 3], b: &[f64; 3], length: f64) -> f64 {
+    let dx = a[0] - b[0];
+    let mut dy = a[1] - b[1];
+    dy -= length * (dy / length).round();
+    let dz = a[2] - b[2];
+    (dx * dx + dy * dy + dz * dz).sqrt()
+}
+
+/// `y` moved by whole periods into `[−length/2, length/2)` (unchanged when already there),
+/// as the DEM engine wraps positions at its seam.
+pub(crate) fn wrap(y: f64, length: f64) -> f64 {
+    let half = 0.5 * length;
+    if (-half..half).contains(&y) {
+        y
+    } else {
+        y - length * ((y + half) / length).floor()
+    }
+}
+
 /// The diagonal of the joint bounding box of the two snapshots: it bounds every pair
 /// distance. Computed per axis first, so that a huge extent shows up as infinity rather
 /// than silently wrapping (NaN if a coordinate is).
@@ -48,6 +72,9 @@ pub(crate) fn diagonal(x0: &[[f64; 3]], x1: &[[f64; 3]]) -> f64 {
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct CostScale {
     unit: f64,
+    /// The period along y of a periodic section: distances are then taken to the nearest
+    /// image ([`periodic_distance`]).
+    period: Option<f64>,
 }
 
 impl CostScale {
@@ -72,7 +99,29 @@ impl CostScale {
                 max_units: MAX_PAIR_UNITS.min(MAX_TOTAL_UNITS / n),
             });
         }
-        Ok(Self { unit })
+        Ok(Self { unit, period: None })
+    }
+
+    /// The same scale with distances taken across a seam of period `period` along y
+    /// (`None`: plain Euclidean distances). A periodic distance is at most the Euclidean one,
+    /// so the bound checked in [`CostScale::new`] still holds.
+    pub(crate) fn with_period(self, period: Option<f64>) -> Self {
+        Self { period, ..self }
+    }
+
+    /// The period along y, if the section is periodic.
+    #[inline]
+    pub(crate) fn period(&self) -> Option<f64> {
+        self.period
+    }
+
+    /// The distance the costs are made of: Euclidean, or periodic along y.
+    #[inline]
+    pub(crate) fn distance(&self, a: &[f64; 3], b: &[f64; 3]) -> f64 {
+        match self.period {
+            None => distance(a, b),
+            Some(length) => periodic_distance(a, b, length),
+        }
     }
 
     /// The length of one integer cost unit.
@@ -98,7 +147,7 @@ impl CostScale {
     /// Integer cost of the pair (t1 point `a`, t0 point `b`).
     #[inline]
     pub(crate) fn cost(&self, a: &[f64; 3], b: &[f64; 3]) -> i64 {
-        self.cost_of_distance(distance(a, b))
+        self.cost_of_distance(self.distance(a, b))
     }
 
     /// [`CostScale::cost`] as the graph stores it: every pair distance is at most the
@@ -130,6 +179,20 @@ mod tests {
                 assert_eq!(s.cost_of_distance(y), y.round() as i64, "{y}");
             }
         }
+    }
+
+    #[test]
+    fn periodic_distances_take_the_nearest_image() {
+        let s = CostScale::new(&[[0.0; 3]], &[[10.0, 0.0, 0.0]], 1.0)
+            .unwrap()
+            .with_period(Some(10.0));
+        assert_eq!(s.distance(&[0.0, 4.5, 0.0], &[0.0, -4.5, 0.0]), 1.0);
+        assert_eq!(s.distance(&[3.0, 1.0, 0.0], &[0.0, 5.0, 0.0]), 5.0);
+        assert_eq!(s.cost(&[0.0, -4.0, 0.0], &[0.0, 4.0, 0.0]), 2);
+        assert_eq!(wrap(5.0, 10.0), -5.0);
+        assert_eq!(wrap(-5.0, 10.0), -5.0);
+        assert_eq!(wrap(2.5, 10.0), 2.5);
+        assert_eq!(wrap(-7.0, 10.0), 3.0);
     }
 
     #[test]

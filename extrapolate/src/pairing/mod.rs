@@ -61,6 +61,12 @@ pub struct PairingOptions {
     /// Run the optimality certificate (and repair until it holds). Without it the
     /// result is optimal on the candidate graph only and `certified` is false.
     pub certify: bool,
+    /// The period `L` along y of a section periodic along its axis (`None`: a drum with end
+    /// caps). A pair's distance is then taken across the seam, its y part to the nearest
+    /// image (`Δy − L · round(Δy / L)`), and positions are wrapped into `[−L/2, L/2)`
+    /// first; the result is exact and certified for that distance
+    /// (docs/pairing.md#periodic-sections). Finite and positive.
+    pub axial_period: Option<f64>,
 }
 
 impl PairingOptions {
@@ -75,6 +81,7 @@ impl PairingOptions {
             k_initial: 24,
             dense_max: 0,
             certify: true,
+            axial_period: None,
         }
     }
 
@@ -104,7 +111,8 @@ pub struct Pairing {
     pub g: Vec<u32>,
     /// The minimised objective: `Σ_p round(|x1[p] − x0[g[p]]| / unit)`.
     pub total_cost: i64,
-    /// `Σ_p |x1[p] − x0[g[p]]|`, in the units of the coordinates (summed in row order).
+    /// `Σ_p |x1[p] − x0[g[p]]|`, in the units of the coordinates (summed in row order);
+    /// with an axial period, the distances across the seam.
     pub total_distance: f64,
     /// Nearest t0 candidates per row in the kNN lists: `k_initial` (times 4/3 on a bed
     /// with a large axial transport), or twice that if the first kNN graph had no
@@ -227,11 +235,38 @@ fn validate(x0: &[[f64; 3]], x1: &[[f64; 3]]) -> Result<usize, PairingError> {
     Ok(x0.len())
 }
 
-fn total_distance(x0: &[[f64; 3]], x1: &[[f64; 3]], g: &[u32]) -> f64 {
-    g.iter()
-        .enumerate()
-        .map(|(p, &q)| cost::distance(&x1[p], &x0[q as usize]))
-        .sum()
+/// `Σ_p |x1[p] − x0[g[p]]|` in row order, across the seam of `period` if given.
+fn total_distance(x0: &[[f64; 3]], x1: &[[f64; 3]], g: &[u32], period: Option<f64>) -> f64 {
+    match period {
+        None => g
+            .iter()
+            .enumerate()
+            .map(|(p, &q)| cost::distance(&x1[p], &x0[q as usize]))
+            .sum(),
+        Some(length) => g
+            .iter()
+            .enumerate()
+            .map(|(p, &q)| cost::periodic_distance(&x1[p], &x0[q as usize], length))
+            .sum(),
+    }
+}
+
+/// Checks an axial period: finite and positive.
+fn check_period(period: Option<f64>) -> Result<(), PairingError> {
+    match period {
+        Some(length) if !(length.is_finite() && length > 0.0) => Err(PairingError::InvalidOption {
+            name: "axial_period",
+            reason: format!("must be finite and > 0, got {length}"),
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The positions with y wrapped into `[−L/2, L/2)` (those already inside keep their bits).
+fn wrapped(x: &[[f64; 3]], length: f64) -> Vec<[f64; 3]> {
+    x.iter()
+        .map(|&[a, y, z]| [a, cost::wrap(y, length), z])
+        .collect()
 }
 
 /// The exact pairing by the dense oracle (Kuhn–Munkres on all n² integer costs).
@@ -243,18 +278,53 @@ fn total_distance(x0: &[[f64; 3]], x1: &[[f64; 3]], g: &[u32]) -> f64 {
 /// coordinates, a `unit` that is not positive or too small for the bed's extent, or
 /// more than [`DENSE_LIMIT`] particles.
 pub fn pair_dense(x0: &[[f64; 3]], x1: &[[f64; 3]], unit: f64) -> Result<Pairing, PairingError> {
+    dense_pairing(x0, x1, unit, None)
+}
+
+/// [`pair_dense`] on a section periodic along y with period `period`: the full matrix of
+/// periodic integer costs (`PairingOptions::axial_period`), positions wrapped into
+/// `[−L/2, L/2)` first. The oracle of the periodic sparse solver.
+///
+/// # Errors
+///
+/// As [`pair_dense`], and [`PairingError::InvalidOption`] for a period that is not finite
+/// and positive.
+pub fn pair_dense_periodic(
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    unit: f64,
+    period: f64,
+) -> Result<Pairing, PairingError> {
+    dense_pairing(x0, x1, unit, Some(period))
+}
+
+fn dense_pairing(
+    x0: &[[f64; 3]],
+    x1: &[[f64; 3]],
+    unit: f64,
+    period: Option<f64>,
+) -> Result<Pairing, PairingError> {
     let start = Instant::now();
     let n = validate(x0, x1)?;
+    check_period(period)?;
     if n > DENSE_LIMIT {
         return Err(PairingError::TooLargeForDense {
             n,
             max: DENSE_LIMIT,
         });
     }
-    let scale = cost::CostScale::new(x0, x1, unit)?;
+    let wrapped_positions;
+    let (x0, x1) = match period {
+        None => (x0, x1),
+        Some(length) => {
+            wrapped_positions = (wrapped(x0, length), wrapped(x1, length));
+            (&wrapped_positions.0[..], &wrapped_positions.1[..])
+        }
+    };
+    let scale = cost::CostScale::new(x0, x1, unit)?.with_period(period);
     let (g, total_cost) = dense::solve(x0, x1, &scale);
     Ok(Pairing {
-        total_distance: total_distance(x0, x1, &g),
+        total_distance: total_distance(x0, x1, &g, period),
         g,
         total_cost,
         k_used: n,
@@ -279,7 +349,8 @@ pub fn pair_dense(x0: &[[f64; 3]], x1: &[[f64; 3]], unit: f64) -> Result<Pairing
 /// [`PairingError`] for snapshots of different or zero length (or more than
 /// `u32::MAX` particles), non-finite coordinates, and out-of-range options
 /// (`k_initial = 0`, `dense_max > DENSE_LIMIT`, a `unit` that is not positive or too
-/// small for the bed's extent). Valid input never panics.
+/// small for the bed's extent, an `axial_period` that is not finite and positive). Valid
+/// input never panics.
 pub fn pair(
     x0: &[[f64; 3]],
     x1: &[[f64; 3]],
@@ -299,10 +370,19 @@ pub fn pair(
             reason: format!("at most {DENSE_LIMIT}, got {}", opts.dense_max),
         });
     }
+    check_period(opts.axial_period)?;
     if n <= opts.dense_max {
-        return pair_dense(x0, x1, opts.unit);
+        return dense_pairing(x0, x1, opts.unit, opts.axial_period);
     }
-    let scale = cost::CostScale::new(x0, x1, opts.unit)?;
+    let wrapped_positions;
+    let (x0, x1) = match opts.axial_period {
+        None => (x0, x1),
+        Some(length) => {
+            wrapped_positions = (wrapped(x0, length), wrapped(x1, length));
+            (&wrapped_positions.0[..], &wrapped_positions.1[..])
+        }
+    };
+    let scale = cost::CostScale::new(x0, x1, opts.unit)?.with_period(opts.axial_period);
     let (mut s, _) = sparse(x0, x1, opts, &scale, true);
     s.seconds = start.elapsed().as_secs_f64();
     Ok(s)
@@ -426,7 +506,15 @@ fn sparse(
     let x0: Vec<[f64; 3]> = perm0.iter().map(|&i| x0_in[i as usize]).collect();
     let x1: Vec<[f64; 3]> = perm1.iter().map(|&i| x1_in[i as usize]).collect();
     let (x0, x1) = (&x0[..], &x1[..]);
-    let grid = candidates::Grid::new(x0);
+    // On a periodic section the candidate search and the certificate's radius queries run
+    // on the t0 points and their images one period away (docs/pairing.md#periodic-sections).
+    let images = scale
+        .period()
+        .map(|length| candidates::Images::of(x0, length));
+    let grid = match &images {
+        None => candidates::Grid::new(x0),
+        Some(images) => candidates::Grid::with_images(images),
+    };
     trace!(t, "morton order + grid, n {n}");
 
     // Candidates and warm-start potentials follow the transport along the bed's long
@@ -435,6 +523,14 @@ fn sparse(
     let centres = axial.centres(x1);
     let shift = axial.mean_abs_shift();
     trace!(t, "axial transport and centres");
+    let knn_graph = |k: usize| {
+        if images.is_some() {
+            candidates::knn_images(&grid, x0, x1, &centres, k, scale)
+        } else {
+            let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k, scale);
+            candidates::Graph::from_knn(k, kc, kw)
+        }
+    };
     // A bed with a large axial transport needs more candidates: the long kiln has no
     // perfect matching at k = 24, and finding that out costs the auction's whole budget
     // (docs/pairing.md#long-drums). The test is `shift > ρ`, ρ the mean cheapest
@@ -453,9 +549,8 @@ fn sparse(
         k_plain
     };
     trace!(t, "sampled mean cheapest pair");
-    let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
+    let mut graph = knn_graph(k0);
     trace!(t, "knn k {k0}");
-    let mut graph = candidates::Graph::from_knn(k0, kc, kw);
     if trace_on() {
         // A pass over the graph (a few milliseconds on 80 000 rows, in the stamps that
         // follow): only with the trace on.
@@ -503,7 +598,11 @@ fn sparse(
     let slab_count = cut.as_ref().map_or(1, slabs::Slabs::count);
     // The certificate's tree depends on the t0 points alone: it is built on the second
     // core while the first runs the sequential auction before the first search.
-    let build_tree = || opts.certify.then(|| certificate::WeightedTree::new(x0));
+    let new_tree = || match &images {
+        None => certificate::WeightedTree::new(x0),
+        Some(images) => certificate::WeightedTree::with_images(images),
+    };
+    let build_tree = || opts.certify.then(new_tree);
     let (mut lap, mut bids, tree) = if let Some(cut) = cut {
         // The slabs stop where the certified path pauses (the global auction repairs
         // the seams at that ε, then carries on as below).
@@ -568,8 +667,7 @@ fn sparse(
         let mut m = feasibility::Matching::from_partial(&lap.col_of_row, &lap.row_of_col_vec());
         if !m.deficient_rows(&graph).is_empty() {
             k0 = (2 * k0).min(n);
-            let (kc, kw) = candidates::knn(&grid, x0, x1, &centres, k0, scale);
-            graph = candidates::Graph::from_knn(k0, kc, kw);
+            graph = knn_graph(k0);
             lap = sparse_lap::Lap::new(n);
             lap.set_potentials(&v_axial);
             lap.greedy_init(&graph);
@@ -588,13 +686,14 @@ fn sparse(
         if !opts.certify || lap.col_of_row.contains(&sparse_lap::NONE) {
             break; // nothing to certify, or the auction stopped on its budget
         }
-        let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
+        let wtree = wtree.get_or_insert_with(new_tree);
         // A throwaway memo: these potentials satisfy ε-CS only, so a pass may also
         // return candidate edges (dropped by the merge). Its bounds would hold later too,
         // but carried over with the slack they made these passes search further while
         // round 1 still re-examined every row (docs/benchmarks.md).
         let check = certificate::check(
             wtree,
+            x0,
             x1,
             &lap,
             &graph,
@@ -670,8 +769,8 @@ fn sparse(
         if !opts.certify {
             break false;
         }
-        let wtree = wtree.get_or_insert_with(|| certificate::WeightedTree::new(x0));
-        let check = certificate::check(wtree, x1, &lap, &graph, scale, &mut memo);
+        let wtree = wtree.get_or_insert_with(new_tree);
+        let check = certificate::check(wtree, x0, x1, &lap, &graph, scale, &mut memo);
         examined += check.examined;
         trace!(
             t,
@@ -711,7 +810,7 @@ fn sparse(
     }
     let pairing = Pairing {
         total_cost,
-        total_distance: total_distance(x0_in, x1_in, &g),
+        total_distance: total_distance(x0_in, x1_in, &g, scale.period()),
         g,
         k_used: k0,
         certified,

@@ -22,6 +22,12 @@ pub struct PairingSummary {
     /// sizes therefore does not reuse).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub size_classes: Option<usize>,
+    /// The period along the axis (m) of a section periodic along it, whose pair distances
+    /// were taken across the seam; absent for a drum with end caps (and in sidecars
+    /// written before periodic sections were paired across their seam, which such a
+    /// section therefore does not reuse).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_period: Option<f64>,
     /// Wall time and worker threads of the solve; left out of a reproducible pairing
     /// (`tdex pair --reproducible`), the only fields that depend on the machine.
     #[serde(default, skip_serializing_if = "Option::is_none")]
