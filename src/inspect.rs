@@ -151,6 +151,35 @@ fn conducting_walls(info: &tdex_format::RecordingInfo) -> usize {
         .count()
 }
 
+/// One size class of a bed: its radius (m) and how many particles have it.
+#[derive(Debug, Serialize)]
+struct SizeClassCount {
+    radius: f64,
+    particles: usize,
+}
+
+/// The size classes of a snapshot, smallest radius first; empty for a bed of one size.
+fn size_classes(s: &Snapshot) -> Vec<SizeClassCount> {
+    let mut radii = s.radius.clone();
+    radii.sort_by(f64::total_cmp);
+    radii.dedup();
+    if radii.len() < 2 {
+        return Vec::new();
+    }
+    radii
+        .into_iter()
+        .map(|radius| SizeClassCount {
+            radius,
+            particles: s.radius.iter().filter(|&&r| r == radius).count(),
+        })
+        .collect()
+}
+
+/// A length in millimetres, to 4 significant digits without float noise.
+fn fmt_mm(metres: f64) -> String {
+    crate::fmt::sig(metres * 1e3, 4)
+}
+
 /// The mean particle temperature of `s` (K).
 fn mean_temperature(s: &Snapshot) -> f64 {
     s.temp.iter().sum::<f64>() / s.len().max(1) as f64
@@ -170,6 +199,13 @@ struct Inspection {
     sampling: Sampling,
     walls: usize,
     conducting_walls: usize,
+    /// A bed of several sizes: each class's radius (m) and particle count, smallest first
+    /// (absent for one size, so that its JSON is as before).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    size_classes: Vec<SizeClassCount>,
+    /// A periodic section: its length along the axis (m); absent for a drum with end caps.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    axial_period: Option<f64>,
     area_encoding: String,
     rows: u64,
     wall_rows: u64,
@@ -525,6 +561,8 @@ fn inspect_recording(plan: &InspectPlan, reader: &RecordingReader) -> Result<()>
         sampling: Sampling::of(&info),
         walls: info.walls.len(),
         conducting_walls: conducting_walls(&info),
+        size_classes: size_classes(t0),
+        axial_period: extrapolate::axial_period(&info),
         area_encoding: format!("{:?}", info.area_encoding).to_lowercase(),
         rows: found.rows,
         wall_rows,
@@ -628,9 +666,28 @@ fn print_human(s: &Inspection) {
         &s.tool_version,
     );
     println!(
-        "case          {}: {} particles, {} walls ({} conducting)",
-        s.case, s.sampling.particles, s.walls, s.conducting_walls
+        "case          {}: {} particles, {} walls ({} conducting){}",
+        s.case,
+        s.sampling.particles,
+        s.walls,
+        s.conducting_walls,
+        match s.axial_period {
+            Some(length) => format!(", a periodic section {} mm long", fmt_mm(length)),
+            None => String::new(),
+        }
     );
+    if !s.size_classes.is_empty() {
+        let classes: Vec<String> = s
+            .size_classes
+            .iter()
+            .map(|c| format!("{} of {} mm", c.particles, fmt_mm(c.radius)))
+            .collect();
+        println!(
+            "sizes         {} classes by radius: {}",
+            s.size_classes.len(),
+            classes.join(", ")
+        );
+    }
     s.sampling.print_period(
         false,
         &format!(
