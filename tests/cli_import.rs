@@ -411,7 +411,7 @@ fn missing_contact_frames_and_a_wrong_case_are_refused() {
 
 /// Writes the deck of `case` with `deck_args` (`tests/liggghts/deck_from_case.py`) into
 /// `run_dir` and runs LIGGGHTS 3.8 there on one process.
-fn run_liggghts(case: &Path, run_dir: &Path, deck_args: &[&str]) {
+pub(crate) fn run_liggghts(case: &Path, run_dir: &Path, deck_args: &[&str]) {
     let deck = std::process::Command::new("python3")
         .arg(repo().join("tests/liggghts/deck_from_case.py"))
         .arg(case)
@@ -566,7 +566,7 @@ fn a_liggghts_run_imports_extrapolates_and_compares() {
 
 /// Σ m c T (J) of a LIGGGHTS atom dump frame (`... radius f_Temp` columns), for the case's
 /// density and heat capacity.
-fn dump_heat(path: &Path, density: f64, heat_capacity: f64) -> f64 {
+pub(crate) fn dump_heat(path: &Path, density: f64, heat_capacity: f64) -> f64 {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
     let columns: Vec<&str> = lines

@@ -12,6 +12,7 @@ mod cli_draws;
 mod cli_export;
 mod cli_extrapolate;
 mod cli_import;
+mod cli_import_sizes;
 mod cli_import_walls;
 mod cli_inspect;
 mod cli_outputs;
