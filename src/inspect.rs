@@ -160,15 +160,14 @@ struct SizeClassCount {
 
 /// The size classes of a snapshot, smallest radius first; empty for a bed of one size.
 fn size_classes(s: &Snapshot) -> Vec<SizeClassCount> {
-    let mut radii = s.radius.clone();
-    radii.sort_by(f64::total_cmp);
-    radii.dedup();
-    if radii.len() < 2 {
+    let classes = crate::compare::classes::SizeClasses::of(&s.radius);
+    if classes.len() < 2 {
         return Vec::new();
     }
-    radii
-        .into_iter()
-        .map(|radius| SizeClassCount {
+    classes
+        .radii
+        .iter()
+        .map(|&radius| SizeClassCount {
             radius,
             particles: s.radius.iter().filter(|&&r| r == radius).count(),
         })
