@@ -1,7 +1,7 @@
 //! Physical validation of a parsed case: every refusal names the field, the value and the limit.
 
 use super::schema::*;
-use super::sizes;
+use super::sizes::{self, SizeClasses};
 use crate::insertion;
 
 /// The largest accepted `dt` as a fraction of the Rayleigh time (the paper runs at 23 %;
@@ -137,7 +137,22 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
         }
     }
 
-    let d = &case.drum;
+    drum(&case.drum, p, &sizes)?;
+    time(&case.time, m, &sizes)?;
+    // which keys each mode needs was settled when the file was read (`TemperatureSpec`)
+    match case.temperature {
+        TemperatureSpec::Split { hot, cold, .. } => {
+            temperature("temperature.hot", hot)?;
+            temperature("temperature.cold", cold)?;
+        }
+        TemperatureSpec::Uniform { value, .. } => temperature("temperature.value", value)?,
+    }
+
+    bed_fits(p, &case.drum, &sizes)
+}
+
+/// The drum's extents against the largest sphere, and its motion and wall.
+fn drum(d: &Drum, p: &ParticlesSpec, sizes: &SizeClasses) -> Result<(), Violation> {
     positive("drum.radius", d.radius)?;
     positive("drum.length", d.length)?;
     match &p.size {
@@ -197,7 +212,12 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
         positive("drum.wall_conductivity", kw)?;
     }
 
-    let t = &case.time;
+    Ok(())
+}
+
+/// The time step against the smallest spheres' Rayleigh time, and the phases' lengths.
+fn time(t: &TimeSpec, m: &Material, sizes: &SizeClasses) -> Result<(), Violation> {
+    let nu = m.poisson_ratio;
     positive("time.dt", t.dt)?;
     // the smallest spheres have the shortest contacts: they bound the step
     let smallest = sizes.smallest();
@@ -226,15 +246,12 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
         positive("time.heating", h)?;
     }
 
-    // which keys each mode needs was settled when the file was read (`TemperatureSpec`)
-    match case.temperature {
-        TemperatureSpec::Split { hot, cold, .. } => {
-            temperature("temperature.hot", hot)?;
-            temperature("temperature.cold", cold)?;
-        }
-        TemperatureSpec::Uniform { value, .. } => temperature("temperature.value", value)?,
-    }
+    Ok(())
+}
 
+/// Whether the settled bed fits the drum, its neighbour grid the machine, and its insertion
+/// the room there is.
+fn bed_fits(p: &ParticlesSpec, d: &Drum, sizes: &SizeClasses) -> Result<(), Violation> {
     // The settled bed must fit, and insertion must have room for every particle.
     let bed_volume = sizes.solid_volume() / BED_PACKING;
     let drum_volume = std::f64::consts::PI * d.radius * d.radius * d.length;
@@ -268,7 +285,7 @@ pub fn validate(case: &Case) -> Result<(), Violation> {
         ));
     }
     if sizes.radius.len() > 1 {
-        let fill = insertion::random_fill(&sizes, d.radius, d.length);
+        let fill = insertion::random_fill(sizes, d.radius, d.length);
         if fill > insertion::MAX_RANDOM_FILL {
             return Err(refuse(
                 "particles.count",
