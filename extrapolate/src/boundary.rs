@@ -20,6 +20,11 @@
 //!   coarse axial drift (the mean step of each bin of the axis in each cell of the
 //!   cross-section, beyond the cell's mean over the axis) by a random offset along the axis:
 //!   the drift the exact map repeats becomes a random walk, and neighbours stay neighbours.
+//!
+//! Between end caps a redrawn step stops at the bed's extent; in a section periodic along
+//! its axis ([`AxialEnds::Periodic`]) steps are taken across the seam to the nearest image
+//! and positions wrap, so the drift's bins tile the period and a moved drift is an exact
+//! translation of the recorded one.
 
 use crate::pairing::{self, PairingOptions};
 use crate::ExtrapolateError;
@@ -86,6 +91,58 @@ impl BoundaryMaps {
     }
 }
 
+/// How the drum's axis ends, which decides what a redrawn axial step does at an end: stop
+/// there (end caps), or cross the seam and come back through the other face (a section
+/// periodic along the axis, [`crate::axial_period`] of the recording).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum AxialEnds {
+    Caps,
+    Periodic { length: f64 },
+}
+
+impl AxialEnds {
+    /// The ends of a recording whose section is periodic with `period` (or capped: `None`).
+    pub fn of(period: Option<f64>) -> Self {
+        period.map_or(Self::Caps, |length| Self::Periodic { length })
+    }
+
+    /// The span a redrawn position must stay in: the bed's extent between caps (from `pos`),
+    /// the section `[−L/2, L/2)` when periodic.
+    fn span(self, pos: &[[f64; 3]]) -> (f64, f64) {
+        match self {
+            Self::Caps => axial_extent(pos),
+            Self::Periodic { length } => (-0.5 * length, 0.5 * length),
+        }
+    }
+
+    /// The axial step from `from` to `to`: across the seam, the nearest image's (a recorded
+    /// particle that crossed it moved by a fraction of a diameter, not by a period).
+    fn step(self, from: f64, to: f64) -> f64 {
+        match self {
+            Self::Caps => to - from,
+            Self::Periodic { length } => {
+                let dy = to - from;
+                dy - length * (dy / length).round()
+            }
+        }
+    }
+
+    /// `y` brought back into `span`: stopped at a cap, or wrapped by whole periods.
+    fn place(self, y: f64, span: (f64, f64)) -> f64 {
+        match self {
+            Self::Caps => y.clamp(span.0, span.1),
+            Self::Periodic { length } => pairing::wrap(y, length),
+        }
+    }
+
+    fn period(self) -> Option<f64> {
+        match self {
+            Self::Caps => None,
+            Self::Periodic { length } => Some(length),
+        }
+    }
+}
+
 /// The extent of the bed along the axis, `(lowest, highest)` `y`.
 fn axial_extent(pos: &[[f64; 3]]) -> (f64, f64) {
     pos.iter()
@@ -103,15 +160,17 @@ fn unit(rng: &mut Xoshiro256PlusPlus) -> f64 {
 /// `end` (`t_p`): each particle keeps its recorded position across the drum (`x`, `z` at
 /// `t_p`); along the axis it takes its position at `t_{p−1}` plus the step of another
 /// particle, drawn without replacement among those ending in the same `cell`-wide square of
-/// the cross-section. The axial position stays within the bed's extent at `t_{p−1}` (a step
-/// drawn near an end cap that would cross it stops at the cap).
+/// the cross-section. Between end caps the axial position stays within the bed's extent at
+/// `t_{p−1}` (a step drawn near an end cap that would cross it stops at the cap); in a
+/// periodic section steps are taken across the seam and positions wrap.
 pub fn fresh_step_ends(
     start: &Snapshot,
     end: &Snapshot,
     cell: f64,
+    axis: AxialEnds,
     rng: &mut Xoshiro256PlusPlus,
 ) -> Vec<[f64; 3]> {
-    step_ends(start, end, &cross_section_cells(&end.pos, cell), rng)
+    step_ends(start, end, &cross_section_cells(&end.pos, cell), axis, rng)
 }
 
 /// [`fresh_step_ends`] with the cross-section's cells found once for the whole pool.
@@ -119,16 +178,17 @@ fn step_ends(
     start: &Snapshot,
     end: &Snapshot,
     cells: &BTreeMap<(i64, i64), Vec<usize>>,
+    axis: AxialEnds,
     rng: &mut Xoshiro256PlusPlus,
 ) -> Vec<[f64; 3]> {
-    let (lowest, highest) = axial_extent(&start.pos);
+    let span = axis.span(&start.pos);
     let mut ends = end.pos.clone();
     for members in cells.values() {
         let mut donors = members.clone();
         shuffle(&mut donors, rng);
         for (&a, &b) in members.iter().zip(&donors) {
-            let step = end.pos[b][1] - start.pos[b][1];
-            ends[a][1] = (start.pos[a][1] + step).clamp(lowest, highest);
+            let step = axis.step(start.pos[b][1], end.pos[b][1]);
+            ends[a][1] = axis.place(start.pos[a][1] + step, span);
         }
     }
     ends
@@ -138,33 +198,48 @@ fn step_ends(
 /// of the cross-section (keyed as [`cross_section_cells`]), the mean axial step of the
 /// particles ending in each `bin`-long bin of the axis (from the lowest end), less the
 /// square's mean over the axis (0 in an empty bin). What the exact map repeats at every
-/// period.
+/// period. In a periodic section the bins tile the period (their length the nearest to
+/// `bin` that divides it) and the steps are taken across the seam.
 #[derive(Debug, Clone)]
 pub struct AxialDrift {
-    /// The bed's extent along the axis at the end, `(lowest, highest)` `y`.
+    /// The span the bins cover, `(lowest, highest)` `y`: the bed's extent at the end between
+    /// caps, the section in a periodic one.
     extent: (f64, f64),
     bin: f64,
     bins: usize,
     cell: f64,
+    axis: AxialEnds,
     pub by_cell: BTreeMap<(i64, i64), Vec<f64>>,
 }
 
 impl AxialDrift {
-    pub fn of(start: &Snapshot, end: &Snapshot, bin: f64, cell: f64) -> Self {
-        let extent = axial_extent(&end.pos);
-        let bins = (((extent.1 - extent.0) / bin).floor() as usize + 1).max(1);
+    pub fn of(start: &Snapshot, end: &Snapshot, bin: f64, cell: f64, axis: AxialEnds) -> Self {
+        let extent = axis.span(&end.pos);
+        let (bin, bins) = match axis {
+            AxialEnds::Caps => (
+                bin,
+                (((extent.1 - extent.0) / bin).floor() as usize + 1).max(1),
+            ),
+            AxialEnds::Periodic { length } => {
+                // whole bins around the seam, so that moving the drift by some of them is a
+                // translation of the section onto itself
+                let bins = ((length / bin).round() as usize).max(1);
+                (length / bins as f64, bins)
+            }
+        };
         let mut drift = Self {
             extent,
             bin,
             bins,
             cell,
+            axis,
             by_cell: BTreeMap::new(),
         };
         for (key, members) in cross_section_cells(&end.pos, cell) {
             let mut sums = vec![(0.0, 0.0); bins];
             let mut total = 0.0;
             for &a in &members {
-                let step = end.pos[a][1] - start.pos[a][1];
+                let step = axis.step(start.pos[a][1], end.pos[a][1]);
                 let b = drift.bin_of(end.pos[a][1]);
                 sums[b].0 += step;
                 sums[b].1 += 1.0;
@@ -189,7 +264,8 @@ impl AxialDrift {
     /// position but for its bin's drift, which becomes the drift of the bin a random offset
     /// further along the axis (the same offset for the whole bed, wrapped around its extent),
     /// so that the drift's pattern, and every particle's place among its neighbours, is the
-    /// recording's. Positions stay within the bed's extent at the end.
+    /// recording's. Positions stay within the bed's extent at the end between caps, and
+    /// wrap in a periodic section.
     pub fn moved_ends(&self, end: &Snapshot, rng: &mut Xoshiro256PlusPlus) -> Vec<[f64; 3]> {
         let offset = ((unit(rng) * self.bins as f64) as usize).min(self.bins - 1);
         end.pos
@@ -198,7 +274,7 @@ impl AxialDrift {
                 let cell_drift = &self.by_cell[&cell_key(&[x, y, z], self.cell)];
                 let b = self.bin_of(y);
                 let moved = y + cell_drift[(b + offset) % self.bins] - cell_drift[b];
-                [x, moved.clamp(self.extent.0, self.extent.1), z]
+                [x, self.axis.place(moved, self.extent), z]
             })
             .collect()
     }
@@ -239,12 +315,14 @@ pub struct Pool {
 
 /// The pool of fresh pairings the boundary `maps` asks for (`None` for the exact one), of the
 /// period from `before` (`t_{p−1}`) to `end` (`t_p`) into `start` (the snapshot, or its
-/// image, a jump enters), drawn from `seed`.
+/// image, a jump enters), drawn from `seed`; in a periodic section (`axis`) the pairings
+/// take their distances across the seam, as the exact one does.
 pub fn fresh_pool(
     maps: BoundaryMaps,
     before: &Snapshot,
     end: &Snapshot,
     start: &Snapshot,
+    axis: AxialEnds,
     seed: u64,
 ) -> Result<Option<Pool>, ExtrapolateError> {
     let d = start.mean_diameter();
@@ -273,6 +351,7 @@ pub fn fresh_pool(
                 end,
                 bin_diameters * d,
                 cell_diameters * d,
+                axis,
             )),
         ),
     };
@@ -281,11 +360,14 @@ pub fn fresh_pool(
     let mut means = Vec::with_capacity(pool as usize);
     for _ in 0..pool {
         let ends = match &redraw {
-            Redraw::Steps(cells) => step_ends(before, end, cells, &mut rng),
+            Redraw::Steps(cells) => step_ends(before, end, cells, axis, &mut rng),
             Redraw::Drift(drift) => drift.moved_ends(end, &mut rng),
         };
         // the moved ends are `end`'s particles: each keeps its radius, and its role's
-        let opts = PairingOptions::for_bed(d, &start.pos, &ends);
+        let opts = PairingOptions {
+            axial_period: axis.period(),
+            ..PairingOptions::for_bed(d, &start.pos, &ends)
+        };
         let p = pairing::pair_by_size(&start.pos, &start.radius, &ends, &end.radius, &opts)?;
         means.push(p.mean_distance_in_diameters(d));
         pairings.push(p.g);
@@ -377,7 +459,7 @@ mod tests {
             p[2] += uniform(&mut rng);
         }
         let end = snapshot(1, end_pos);
-        let ends = fresh_step_ends(&start, &end, 2.0, &mut rng);
+        let ends = fresh_step_ends(&start, &end, 2.0, AxialEnds::Caps, &mut rng);
         let mut redrawn = 0;
         for members in cross_section_cells(&end.pos, 2.0).values() {
             let sorted = |mut steps: Vec<f64>| {
@@ -413,7 +495,7 @@ mod tests {
         let end = snapshot(1, vec![[0.0, -5.0, 0.0], [0.0, 15.0, 0.0]]);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
         for _ in 0..8 {
-            let ends = fresh_step_ends(&start, &end, 3.0, &mut rng);
+            let ends = fresh_step_ends(&start, &end, 3.0, AxialEnds::Caps, &mut rng);
             assert!(
                 ends.iter().all(|p| (0.0..=10.0).contains(&p[1])),
                 "{ends:?}"
@@ -477,7 +559,9 @@ mod tests {
                 pool: 16,
                 cell_diameters: cell / d,
             };
-            let pool = fresh_pool(steps, &start, &end, &start, 3).unwrap().unwrap();
+            let pool = fresh_pool(steps, &start, &end, &start, AxialEnds::Caps, 3)
+                .unwrap()
+                .unwrap();
             let mut draws = PoolDraws::new(3);
             msd_after(&mut || pool.maps[draws.next(16)].clone(), k)
         };
@@ -500,6 +584,84 @@ mod tests {
         );
     }
 
+    /// In a periodic section a step is taken across the seam (a particle that left through
+    /// one face and came back through the other moved by its step, not by a period), and a
+    /// redrawn position wraps into the section instead of stopping at an end.
+    #[test]
+    fn in_a_periodic_section_steps_cross_the_seam_and_positions_wrap() {
+        let axis = AxialEnds::Periodic { length: 10.0 };
+        // one cell of the cross-section: the first crosses the seam (4.5 → −4.5, a step of
+        // +1), the second moves 0.5 in the middle
+        let start = snapshot(0, vec![[0.0, 4.5, 0.0], [0.0, 0.0, 0.0]]);
+        let end = snapshot(1, vec![[0.0, -4.5, 0.0], [0.0, 0.5, 0.0]]);
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(1);
+        let mut swapped = false;
+        for _ in 0..16 {
+            let ends = fresh_step_ends(&start, &end, 3.0, axis, &mut rng);
+            assert!(ends.iter().all(|p| (-5.0..5.0).contains(&p[1])), "{ends:?}");
+            let mut steps: Vec<f64> = (0..2)
+                .map(|a| axis.step(start.pos[a][1], ends[a][1]))
+                .collect();
+            swapped |= (steps[0] - 0.5).abs() < 1e-12;
+            steps.sort_by(f64::total_cmp);
+            assert!((steps[0] - 0.5).abs() < 1e-12 && (steps[1] - 1.0).abs() < 1e-12);
+        }
+        assert!(swapped, "the steps are redrawn");
+        // between end caps the same recording's crossing is a step of −9 and stops at a cap
+        let capped = fresh_step_ends(&start, &end, 3.0, AxialEnds::Caps, &mut rng);
+        assert!(
+            capped.iter().all(|p| (0.0..=4.5).contains(&p[1])),
+            "{capped:?}"
+        );
+    }
+
+    /// In a periodic section the drift's bins tile the period, so a fresh drift is the
+    /// recorded one moved round the section: every bin of a cell moves as one, by the drift
+    /// of the bin one offset further less its own, and the ends stay in the section.
+    #[test]
+    fn a_periodic_drift_tiles_the_section_and_moves_round_it() {
+        let length = 60.0;
+        let axis = AxialEnds::Periodic { length };
+        let bed = random_bed(3000, (8.0, length, 3.0), 11);
+        let start = snapshot(0, bed.iter().map(|&[x, y, z]| [x, y - 30.0, z]).collect());
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut() {
+            let drift = if (p[1] / 6.0).floor() as i64 % 2 == 0 {
+                0.8
+            } else {
+                -0.8
+            };
+            p[1] = pairing::wrap(p[1] + drift + uniform(&mut rng), length);
+        }
+        let end = snapshot(1, end_pos);
+        let odd = AxialDrift::of(&start, &end, 7.0, 4.0, axis);
+        assert_eq!((odd.bins, odd.bin), (9, length / 9.0));
+        let recorded = AxialDrift::of(&start, &end, 2.0, 4.0, axis);
+        assert_eq!(recorded.bins, 30);
+        // the recorded drift carries the ±0.8 pattern
+        let cell0 = &recorded.by_cell[&(0, 0)];
+        let spread = cell0.iter().map(|d| d * d).sum::<f64>() / cell0.len() as f64;
+        assert!(spread > 0.3, "{cell0:?}");
+        let mut offsets_seen = std::collections::BTreeSet::new();
+        for _ in 0..6 {
+            let ends = recorded.moved_ends(&end, &mut rng);
+            assert!(ends.iter().all(|p| (-30.0..30.0).contains(&p[1])));
+            let offset = (0..recorded.bins)
+                .find(|&o| {
+                    end.pos.iter().zip(&ends).all(|(e, m)| {
+                        let drift = &recorded.by_cell[&cell_key(e, 4.0)];
+                        let b = recorded.bin_of(e[1]);
+                        let by = axis.step(e[1], m[1]);
+                        (drift[(b + o) % recorded.bins] - drift[b] - by).abs() < 1e-9
+                    })
+                })
+                .expect("one offset explains every particle's move");
+            offsets_seen.insert(offset);
+        }
+        assert!(offsets_seen.len() > 1, "{offsets_seen:?}");
+    }
+
     #[test]
     fn the_drift_is_each_bins_mean_step_beyond_its_cells_mean() {
         // one cell of the cross-section; bins of 2 along the axis from the lowest end, y = 0
@@ -507,7 +669,7 @@ mod tests {
         let start = snapshot(0, at([-1.0, 0.5, 3.0, 5.0]));
         let end = snapshot(1, at([0.0, 1.5, 2.5, 5.0]));
         // steps 1, 1, −0.5, 0 (mean 0.375); ends in bins 0, 0, 1, 2
-        let drift = AxialDrift::of(&start, &end, 2.0, 3.0).by_cell;
+        let drift = AxialDrift::of(&start, &end, 2.0, 3.0, AxialEnds::Caps).by_cell;
         assert_eq!(drift.len(), 1);
         let bins = &drift[&(0, 0)];
         let expected = [1.0 - 0.375, -0.5 - 0.375, 0.0 - 0.375];
@@ -536,7 +698,7 @@ mod tests {
         }
         let end = snapshot(1, end_pos);
         let (bin, cell) = (2.0, 4.0);
-        let recorded = AxialDrift::of(&start, &end, bin, cell);
+        let recorded = AxialDrift::of(&start, &end, bin, cell, AxialEnds::Caps);
         let drift = &recorded.by_cell;
         let spread = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
         let mut offsets_seen = std::collections::BTreeSet::new();
@@ -592,14 +754,21 @@ mod tests {
             cell_diameters: 3.0,
         };
         let pool = |seed| {
-            fresh_pool(steps, &start, &end, &start, seed)
+            fresh_pool(steps, &start, &end, &start, AxialEnds::Caps, seed)
                 .unwrap()
                 .unwrap()
         };
         let (one, again, other) = (pool(9), pool(9), pool(10));
-        assert!(fresh_pool(BoundaryMaps::Exact, &start, &end, &start, 9)
-            .unwrap()
-            .is_none());
+        assert!(fresh_pool(
+            BoundaryMaps::Exact,
+            &start,
+            &end,
+            &start,
+            AxialEnds::Caps,
+            9
+        )
+        .unwrap()
+        .is_none());
         assert_eq!(one.maps, again.maps);
         assert_ne!(one.maps, other.maps);
         assert_ne!(one.maps[0], one.maps[1]);

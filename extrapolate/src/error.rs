@@ -59,14 +59,6 @@ pub enum ExtrapolateError {
         recording.display()
     )]
     NoDrumAxis { recording: PathBuf },
-    /// Fresh boundary maps asked of a periodic section.
-    #[error(
-        "{}: its drum is a section periodic along its axis (period {period} m); fresh \
-         boundary maps redraw the particles' steps between end caps and do not wrap them \
-         across the seam (use --boundary exact)",
-        recording.display()
-    )]
-    FreshMapsOfPeriodicSection { recording: PathBuf, period: f64 },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -86,8 +78,7 @@ impl Classify for ExtrapolateError {
             | ExtrapolateError::RecordedPeriods { .. }
             | ExtrapolateError::JumpTarget { .. }
             | ExtrapolateError::NoMirrorImage { .. }
-            | ExtrapolateError::NoDrumAxis { .. }
-            | ExtrapolateError::FreshMapsOfPeriodicSection { .. } => Fault::Input,
+            | ExtrapolateError::NoDrumAxis { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }
             | ExtrapolateError::Output(_)

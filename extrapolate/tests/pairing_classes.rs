@@ -429,7 +429,7 @@ fn the_fresh_pools_keep_the_classes() {
             cell_diameters: 3.0,
         },
     ] {
-        let pool = boundary::fresh_pool(maps, &before, &end, &before, 3)
+        let pool = boundary::fresh_pool(maps, &before, &end, &before, boundary::AxialEnds::Caps, 3)
             .unwrap()
             .unwrap();
         assert_eq!(pool.maps.len(), 4);

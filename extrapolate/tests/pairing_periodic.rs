@@ -2,20 +2,18 @@
 //! exact against the dense oracle on the periodic cost matrix, across the seam where the
 //! particles crossed it, the same as without a period when the period is far longer than the
 //! bed, optimal within each size class; and its callers: the recording's period, a sidecar
-//! computed without it is stale, fresh boundary maps refused.
+//! computed without it is stale, fresh boundary maps across the seam.
 
 mod common;
 
 use common::{is_permutation, Rng};
-use extrapolate::boundary::BoundaryMaps;
+use extrapolate::boundary::{fresh_pool, AxialEnds, BoundaryMaps};
 use extrapolate::pairing::{
     pair, pair_by_size, pair_dense_periodic, respects_classes, Pairing, PairingError,
     PairingOptions,
 };
 use extrapolate::sidecar::StoredPairing;
-use extrapolate::{
-    axial_period, cache, extrapolate_recording, ExtrapolateError, ExtrapolationRequest, MemoryLimit,
-};
+use extrapolate::{axial_period, cache, extrapolate_recording, ExtrapolationRequest, MemoryLimit};
 use proptest::prelude::*;
 use std::path::Path;
 use tdex_format::{
@@ -409,6 +407,16 @@ fn snapshots(rng: &mut Rng) -> (Snapshot, Snapshot) {
 fn write_recording(path: &Path, case_resolved: serde_json::Value) -> (Snapshot, Snapshot) {
     let mut rng = Rng::new(21);
     let (t0, t1) = snapshots(&mut rng);
+    write_snapshots(path, case_resolved, (t0, t1), &mut rng)
+}
+
+/// A recording of `t0`, `t1` and a table of 100 random rows.
+fn write_snapshots(
+    path: &Path,
+    case_resolved: serde_json::Value,
+    (t0, t1): (Snapshot, Snapshot),
+    rng: &mut Rng,
+) -> (Snapshot, Snapshot) {
     let mut writer = RecordingWriter::create(path, info(case_resolved)).unwrap();
     writer.write_snapshot(&t0).unwrap();
     writer.write_snapshot(&t1).unwrap();
@@ -502,20 +510,71 @@ fn a_sidecar_without_the_period_is_stale_for_a_periodic_recording() {
     assert!(cache::load(&capped_reader, &t0, &t1).is_some());
 }
 
-/// Fresh boundary maps redraw steps between end caps: refused for a periodic section.
+/// Fresh boundary maps of a periodic section take the recorded steps across the seam and
+/// pair across it. The bed moved 5 mm (± 1 mm) along the axis, a part of it across the seam,
+/// with 15 mm between lattice planes: whatever steps are redrawn, each particle's nearest
+/// role is the one the exact pairing gives it, so every map of the pool is that pairing;
+/// maps blind to the seam stop the particles that crossed it at the far end of the bed and
+/// hand them other roles. Heat is conserved and the output is the seed's.
 #[test]
-fn fresh_boundary_maps_are_refused_for_a_periodic_section() {
+fn fresh_boundary_maps_of_a_periodic_section_cross_the_seam() {
     let dir = tempfile::tempdir().unwrap();
     let rec = dir.path().join("run.mcap");
-    write_recording(&rec, periodic_case());
-    let mut req = request(&rec, &dir.path().join("x.mcap"));
-    req.boundary = BoundaryMaps::FreshSteps {
-        pool: 2,
-        cell_diameters: 3.0,
-    };
-    let e = extrapolate_recording(&req, |_| {}).unwrap_err();
-    assert!(
-        matches!(e, ExtrapolateError::FreshMapsOfPeriodicSection { period, .. } if period == LENGTH),
-        "{e}"
-    );
+    // each particle keeps its index, as in a recording, and moves 5 mm (± 1 mm) along the
+    // axis: the top layer of the lattice crosses the seam
+    let mut rng = Rng::new(22);
+    let (t0, _) = snapshots(&mut rng);
+    let mut t1 = t0.clone();
+    t1.index = 1;
+    t1.time = TAU as f64 * 1e-5;
+    for p in &mut t1.pos {
+        let y = p[1] + 0.005 + rng.range(-1e-3, 1e-3);
+        p[1] = if y >= 0.5 * LENGTH { y - LENGTH } else { y };
+    }
+    let (t0, t1) = write_snapshots(&rec, periodic_case(), (t0, t1), &mut rng);
+    let exact = cache::compute(&t0, &t1, Some(LENGTH)).unwrap();
+    for maps in [
+        BoundaryMaps::FreshSteps {
+            pool: 4,
+            cell_diameters: 3.0,
+        },
+        BoundaryMaps::FreshDrift {
+            pool: 4,
+            bin_diameters: 1.0,
+            cell_diameters: 3.0,
+        },
+    ] {
+        let run = |name: &str| {
+            let mut req = request(&rec, &dir.path().join(name));
+            req.boundary = maps;
+            extrapolate_recording(&req, |_| {}).unwrap()
+        };
+        let outcome = run("a.mcap");
+        assert_eq!(outcome.fresh_pools.len(), 1);
+        let pool = &outcome.fresh_pools[0];
+        assert!(
+            (pool.mean_distance_diameters - exact.summary.mean_distance_diameters).abs() < 0.05,
+            "{maps:?}: pool {pool:?}, exact {:?}",
+            exact.summary
+        );
+        let periodic = AxialEnds::Periodic { length: LENGTH };
+        let across = fresh_pool(maps, &t0, &t1, &t0, periodic, 5)
+            .unwrap()
+            .unwrap();
+        assert!(across.maps.iter().all(|g| *g == exact.g), "{maps:?}");
+        let seam_blind = fresh_pool(maps, &t0, &t1, &t0, AxialEnds::Caps, 5)
+            .unwrap()
+            .unwrap();
+        assert!(seam_blind.maps.iter().all(|g| *g != exact.g), "{maps:?}");
+        let heat = (outcome.total_heat_end - outcome.total_heat_t1).abs() / outcome.total_heat_t1;
+        assert!(heat < 1e-12, "{maps:?}: heat changed by {heat:e}");
+        assert_eq!(
+            std::fs::read(dir.path().join("a.mcap")).unwrap(),
+            {
+                run("b.mcap");
+                std::fs::read(dir.path().join("b.mcap")).unwrap()
+            },
+            "{maps:?}: the same seed gives the same bytes"
+        );
+    }
 }

@@ -6,7 +6,7 @@ use super::{
     axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck,
     Notice, TableChoice,
 };
-use crate::boundary::{self, BoundaryMaps, Pool, PoolDraws};
+use crate::boundary::{self, AxialEnds, BoundaryMaps, Pool, PoolDraws};
 use crate::cache;
 use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
@@ -109,13 +109,6 @@ impl<'a> Extrapolation<'a> {
         if request.boundary != BoundaryMaps::Exact && !has_mirror_image(&info) {
             return Err(ExtrapolateError::NoDrumAxis {
                 recording: request.recording.clone(),
-            });
-        }
-        if let (true, Some(period)) = (request.boundary != BoundaryMaps::Exact, axial_period(&info))
-        {
-            return Err(ExtrapolateError::FreshMapsOfPeriodicSection {
-                recording: request.recording.clone(),
-                period,
             });
         }
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
@@ -244,13 +237,19 @@ impl<'a> Extrapolation<'a> {
     fn fresh_pools(&mut self) -> Result<Vec<(u32, Pool)>, ExtrapolateError> {
         let started = Instant::now();
         let before = &self.snaps[self.used as usize - 1];
+        let axis = AxialEnds::of(axial_period(&self.info));
         let mut pools = Vec::new();
         for p in &self.pairings {
             let start = start_image(&self.snaps, p.period, self.request.symmetry);
             let seed = self.seed.wrapping_add(u64::from(p.period));
-            if let Some(pool) =
-                boundary::fresh_pool(self.request.boundary, before, self.end(), &start, seed)?
-            {
+            if let Some(pool) = boundary::fresh_pool(
+                self.request.boundary,
+                before,
+                self.end(),
+                &start,
+                axis,
+                seed,
+            )? {
                 pools.push((p.period, pool));
             }
         }
