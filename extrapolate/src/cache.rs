@@ -58,7 +58,7 @@ pub fn compute(
         ..PairingOptions::for_bed(d, &t0.pos, &t1.pos)
     };
     let p = pairing::pair_by_size(&t0.pos, &t0.radius, &t1.pos, &t1.radius, &opts)?;
-    let classes = pairing::class_radii(&t0.radius).len();
+    let classes = t0.size_classes().len();
     Ok(StoredPairing {
         snapshots_fingerprint: fingerprint(t0, t1),
         summary: PairingSummary {
@@ -127,7 +127,7 @@ pub fn load_image(
     let n = reader.info().particles as usize;
     let path = sidecar_path(reader, t1.index, start.index, symmetry);
     let stored = sidecar::read(&path, n).ok()??;
-    let classes = pairing::class_radii(&t1.radius).len();
+    let classes = t1.size_classes().len();
     let fresh = stored.snapshots_fingerprint == fingerprint(start, t1)
         && stored.summary.size_classes.unwrap_or(1) == classes
         && pairing::respects_classes(&stored.g, &start.radius, &t1.radius)

@@ -8,8 +8,7 @@ mod common;
 use common::{is_permutation, Rng};
 use extrapolate::boundary::{self, BoundaryMaps};
 use extrapolate::pairing::{
-    class_radii, pair, pair_by_size, pair_dense, respects_classes, Pairing, PairingError,
-    PairingOptions,
+    pair, pair_by_size, pair_dense, respects_classes, Pairing, PairingError, PairingOptions,
 };
 use extrapolate::sidecar::StoredPairing;
 use extrapolate::{cache, extrapolate_recording, ExtrapolationRequest, MemoryLimit};
@@ -99,7 +98,7 @@ proptest! {
         }
         prop_assert!(s.certified);
         let mut total = 0;
-        for radius in class_radii(&r0) {
+        for radius in tdex_format::size_classes(&r0) {
             let (x0c, members0) = of_radius(&x0, &r0, radius);
             let (x1c, members1) = of_radius(&x1, &r1, radius);
             let oracle = pair_dense(&x0c, &x1c, opts.unit).unwrap();

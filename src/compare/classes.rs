@@ -20,12 +20,12 @@ pub struct SizeClasses {
 }
 
 impl SizeClasses {
-    /// The distinct radii of `radius`, smallest first (NaN radii belong to no class).
+    /// The distinct radii of `radius`, smallest first: the classes the pairing keeps
+    /// ([`tdex_format::size_classes`]).
     pub fn of(radius: &[f64]) -> Self {
-        let mut radii: Vec<f64> = radius.iter().copied().filter(|r| !r.is_nan()).collect();
-        radii.sort_by(f64::total_cmp);
-        radii.dedup();
-        Self { radii }
+        Self {
+            radii: tdex_format::size_classes(radius),
+        }
     }
 
     pub fn len(&self) -> usize {

@@ -4,18 +4,6 @@ use super::{pair, total_distance, validate, Pairing, PairingError, PairingOption
 use std::collections::BTreeMap;
 use std::time::Instant;
 
-/// The distinct radii of a snapshot, ascending: one per size class (radii told apart by
-/// their bits, ordered by `f64::total_cmp`).
-#[must_use]
-pub fn class_radii(radius: &[f64]) -> Vec<f64> {
-    let mut radii: Vec<f64> = members_by_radius(radius)
-        .into_keys()
-        .map(f64::from_bits)
-        .collect();
-    radii.sort_by(f64::total_cmp);
-    radii
-}
-
 /// Whether `g` keeps every particle in its class: `g` holds one index into `r0` per entry
 /// of `r1`, each in range, and `r0[g[p]]` has the bits of `r1[p]` for every `p`. A stored
 /// pairing of a bed of several sizes that fails this was not computed for these radii.
@@ -171,11 +159,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn classes_are_told_apart_by_bits_and_ordered_by_radius() {
-        assert_eq!(class_radii(&[2.0, 1.0, 2.0, 0.5]), [0.5, 1.0, 2.0]);
-        assert_eq!(class_radii(&[]), Vec::<f64>::new());
-        // 0.1 + 0.2 is not 0.3 bit for bit: two classes
-        assert_eq!(class_radii(&[0.3, 0.1 + 0.2]).len(), 2);
+    fn one_size_means_the_bits_of_the_first_radius_throughout() {
         assert!(one_size(&[], &[]));
         assert!(one_size(&[1.0, 1.0], &[1.0]));
         assert!(!one_size(&[1.0, 1.0], &[1.0, 2.0]));

@@ -38,7 +38,7 @@ mod sparse_lap;
 
 use std::time::Instant;
 
-pub use classes::{class_radii, pair_by_size, respects_classes};
+pub use classes::{pair_by_size, respects_classes};
 pub(crate) use cost::wrap;
 pub use cycles::{cycle_structure, CycleStructure, SHORT_CYCLE};
 pub use dense::DENSE_LIMIT;

@@ -23,7 +23,7 @@ pub use extrapolation::{
 };
 pub use reader::RecordingReader;
 pub use sidecar::{PairingSummary, StoredPairing};
-pub use snapshot::Snapshot;
+pub use snapshot::{size_classes, Snapshot};
 pub use table::TableBatch;
 pub use writer::RecordingWriter;
 

@@ -23,6 +23,18 @@ pub const POINT_STRIDE: usize = 68;
 /// Frame of the drum's axes (x across, y along the axis, z up).
 pub const FRAME_ID: &str = "drum";
 
+/// The distinct radii of a bed (m), smallest first: one per size class, as the engine gives
+/// each class one radius. Radii are told apart by their bits, so that the pairing (which
+/// keeps each particle on a role of the same bits) and the comparison (which reports by
+/// class) count the same classes; a file's radii are finite and positive
+/// ([`Snapshot::decode`]), for which bits and values agree.
+pub fn size_classes(radius: &[f64]) -> Vec<f64> {
+    let bits: std::collections::BTreeSet<u64> = radius.iter().map(|r| r.to_bits()).collect();
+    let mut radii: Vec<f64> = bits.into_iter().map(f64::from_bits).collect();
+    radii.sort_by(f64::total_cmp);
+    radii
+}
+
 /// The particles at one instant, in fixed-id order (`id[k] == k`).
 #[derive(Debug, Clone, PartialEq, Default, serde::Serialize, serde::Deserialize)]
 pub struct Snapshot {
@@ -44,6 +56,11 @@ impl Snapshot {
 
     pub fn is_empty(&self) -> bool {
         self.id.is_empty()
+    }
+
+    /// The bed's size classes: its distinct radii (m), smallest first ([`size_classes`]).
+    pub fn size_classes(&self) -> Vec<f64> {
+        size_classes(&self.radius)
     }
 
     /// Mean particle diameter (m); 0 for an empty snapshot.
@@ -93,7 +110,9 @@ impl Snapshot {
         .encode_to_vec()
     }
 
-    /// Decodes a point cloud written by [`Snapshot::encode`]; the error says what is wrong.
+    /// Decodes a point cloud written by [`Snapshot::encode`]; the error says what is wrong,
+    /// among which a radius that is not finite and positive (every contact law, capacity and
+    /// size class divides by or sorts on it).
     pub fn decode(index: u32, bytes: &[u8]) -> Result<Self, String> {
         let cloud = PointCloud::decode(bytes).map_err(|e| format!("snapshot {index}: {e}"))?;
         let layout: Vec<(&str, u32, i32)> = cloud
@@ -131,6 +150,61 @@ impl Snapshot {
             snap.radius.push(f64_at(p, 36));
             snap.vel.push([f64_at(p, 44), f64_at(p, 52), f64_at(p, 60)]);
         }
+        if let Some(k) = snap
+            .radius
+            .iter()
+            .position(|r| !(r.is_finite() && *r > 0.0))
+        {
+            return Err(format!(
+                "snapshot {index}: particle {k} (id {}) has radius {} m; a radius is finite and \
+                 positive",
+                snap.id[k], snap.radius[k]
+            ));
+        }
         Ok(snap)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn bed(radius: Vec<f64>) -> Snapshot {
+        let n = radius.len();
+        Snapshot {
+            index: 1,
+            time: 0.5,
+            id: (0..n as u32).collect(),
+            pos: vec![[0.0, 0.01, 0.02]; n],
+            radius,
+            temp: vec![300.0; n],
+            vel: vec![[0.0; 3]; n],
+        }
+    }
+
+    #[test]
+    fn size_classes_are_told_apart_by_bits_and_ordered_by_radius() {
+        assert_eq!(size_classes(&[2.0, 1.0, 2.0, 0.5]), [0.5, 1.0, 2.0]);
+        assert_eq!(size_classes(&[]), Vec::<f64>::new());
+        // 0.1 + 0.2 is not 0.3 bit for bit: two classes
+        assert_eq!(size_classes(&[0.3, 0.1 + 0.2]).len(), 2);
+        assert_eq!(
+            bed(vec![0.002, 0.001, 0.002]).size_classes(),
+            [0.001, 0.002]
+        );
+    }
+
+    #[test]
+    fn a_radius_that_is_not_finite_and_positive_is_refused_on_reading() {
+        let good = bed(vec![0.002, 0.001]);
+        assert_eq!(Snapshot::decode(1, &good.encode()).unwrap(), good);
+        for r in [0.0, -0.001, f64::NAN, f64::INFINITY] {
+            let e = Snapshot::decode(1, &bed(vec![0.002, r]).encode()).unwrap_err();
+            assert!(
+                e.starts_with("snapshot 1: particle 1 (id 1) has radius")
+                    && e.ends_with("a radius is finite and positive"),
+                "{e}"
+            );
+        }
     }
 }
