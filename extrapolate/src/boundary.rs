@@ -444,6 +444,25 @@ mod tests {
             .collect()
     }
 
+    /// `start` a period later: a drift along the axis that changes sign every 6 (±0.8), and
+    /// a step of each particle's own besides, the end position brought back by `place`.
+    fn banded_drift(
+        start: &Snapshot,
+        rng: &mut Xoshiro256PlusPlus,
+        place: impl Fn(f64) -> f64,
+    ) -> Snapshot {
+        let mut end_pos = start.pos.clone();
+        for p in end_pos.iter_mut() {
+            let drift = if (p[1] / 6.0).floor() as i64 % 2 == 0 {
+                0.8
+            } else {
+                -0.8
+            };
+            p[1] = place(p[1] + drift + uniform(rng));
+        }
+        snapshot(1, end_pos)
+    }
+
     #[test]
     fn fresh_steps_keep_the_cross_section_and_redraw_each_cells_axial_steps() {
         let mut start_pos = random_bed(2000, (10.0, 50.0, 4.0), 1);
@@ -625,16 +644,7 @@ mod tests {
         let bed = random_bed(3000, (8.0, length, 3.0), 11);
         let start = snapshot(0, bed.iter().map(|&[x, y, z]| [x, y - 30.0, z]).collect());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
-        let mut end_pos = start.pos.clone();
-        for p in end_pos.iter_mut() {
-            let drift = if (p[1] / 6.0).floor() as i64 % 2 == 0 {
-                0.8
-            } else {
-                -0.8
-            };
-            p[1] = pairing::wrap(p[1] + drift + uniform(&mut rng), length);
-        }
-        let end = snapshot(1, end_pos);
+        let end = banded_drift(&start, &mut rng, |y| pairing::wrap(y, length));
         let odd = AxialDrift::of(&start, &end, 7.0, 4.0, axis);
         assert_eq!((odd.bins, odd.bin), (9, length / 9.0));
         let recorded = AxialDrift::of(&start, &end, 2.0, 4.0, axis);
@@ -686,17 +696,7 @@ mod tests {
     fn a_fresh_drift_moves_each_bin_as_one_by_the_drift_of_another() {
         let start = snapshot(0, random_bed(3000, (8.0, 60.0, 3.0), 7));
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
-        let mut end_pos = start.pos.clone();
-        for p in end_pos.iter_mut() {
-            // a drift that changes sign every 6 along the axis, and particle steps
-            let drift = if (p[1] / 6.0).floor() as i64 % 2 == 0 {
-                0.8
-            } else {
-                -0.8
-            };
-            p[1] = (p[1] + drift + uniform(&mut rng)).clamp(0.0, 60.0);
-        }
-        let end = snapshot(1, end_pos);
+        let end = banded_drift(&start, &mut rng, |y| y.clamp(0.0, 60.0));
         let (bin, cell) = (2.0, 4.0);
         let recorded = AxialDrift::of(&start, &end, bin, cell, AxialEnds::Caps);
         let drift = &recorded.by_cell;

@@ -5,8 +5,8 @@
 
 mod common;
 
-use common::{is_permutation, Rng};
-use extrapolate::boundary::{self, BoundaryMaps};
+use common::{fresh_maps, is_permutation, Rng};
+use extrapolate::boundary;
 use extrapolate::pairing::{
     pair, pair_by_size, pair_dense, respects_classes, Pairing, PairingError, PairingOptions,
 };
@@ -417,17 +417,7 @@ fn a_bed_of_one_size_stores_no_class_count() {
 fn the_fresh_pools_keep_the_classes() {
     let mut rng = Rng::new(13);
     let (before, end) = (snapshot(0, &mut rng), snapshot(1, &mut rng));
-    for maps in [
-        BoundaryMaps::FreshSteps {
-            pool: 4,
-            cell_diameters: 3.0,
-        },
-        BoundaryMaps::FreshDrift {
-            pool: 4,
-            bin_diameters: 2.0,
-            cell_diameters: 3.0,
-        },
-    ] {
+    for maps in fresh_maps(4, 2.0) {
         let pool = boundary::fresh_pool(maps, &before, &end, &before, boundary::AxialEnds::Caps, 3)
             .unwrap()
             .unwrap();

@@ -6,8 +6,8 @@
 
 mod common;
 
-use common::{is_permutation, Rng};
-use extrapolate::boundary::{fresh_pool, AxialEnds, BoundaryMaps};
+use common::{fresh_maps, is_permutation, Rng};
+use extrapolate::boundary::{fresh_pool, AxialEnds};
 use extrapolate::pairing::{
     pair, pair_by_size, pair_dense_periodic, respects_classes, Pairing, PairingError,
     PairingOptions,
@@ -533,17 +533,7 @@ fn fresh_boundary_maps_of_a_periodic_section_cross_the_seam() {
     }
     let (t0, t1) = write_snapshots(&rec, periodic_case(), (t0, t1), &mut rng);
     let exact = cache::compute(&t0, &t1, Some(LENGTH)).unwrap();
-    for maps in [
-        BoundaryMaps::FreshSteps {
-            pool: 4,
-            cell_diameters: 3.0,
-        },
-        BoundaryMaps::FreshDrift {
-            pool: 4,
-            bin_diameters: 1.0,
-            cell_diameters: 3.0,
-        },
-    ] {
+    for maps in fresh_maps(4, 1.0) {
         let run = |name: &str| {
             let mut req = request(&rec, &dir.path().join(name));
             req.boundary = maps;

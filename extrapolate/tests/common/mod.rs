@@ -5,8 +5,25 @@
 
 use std::f64::consts::PI;
 
+use extrapolate::boundary::BoundaryMaps;
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+
+/// Both kinds of fresh boundary maps, pools of `pool` pairings, cells of 3 diameters, the
+/// drift's bins `bin_diameters` long.
+pub fn fresh_maps(pool: u32, bin_diameters: f64) -> [BoundaryMaps; 2] {
+    [
+        BoundaryMaps::FreshSteps {
+            pool,
+            cell_diameters: 3.0,
+        },
+        BoundaryMaps::FreshDrift {
+            pool,
+            bin_diameters,
+            cell_diameters: 3.0,
+        },
+    ]
+}
 
 /// Small seeded generator with the few draws we need.
 pub struct Rng(Xoshiro256PlusPlus);
