@@ -431,9 +431,10 @@ pub fn table(c: &ClassComparison, kind: SecondKind) -> String {
     s
 }
 
-/// Synthetic beds for the tests of the comparison and the report.
-#[cfg(test)]
-pub(crate) mod synthetic {
+/// Synthetic beds for the tests of the comparison and of the report (which the `tdex`
+/// binary's tests reach, so the module is compiled outside `cfg(test)` too).
+#[doc(hidden)]
+pub mod synthetic {
     use super::*;
 
     /// A snapshot of particles at `pos` (x, z) with `radius` and `temp`.

@@ -1084,44 +1084,11 @@ fn field_section(d: &mut Document, inp: &Inputs) {
 mod tests {
     use super::*;
 
-    /// A bed of 3 classes at t_k: 2 particles of 1 mm in the core, 2 of 1.5 mm between, 2
-    /// of 2 mm outside, at `base` + 0, 10 and 20 K.
-    fn three_classes(k: u32, base: f64) -> tdex_format::Snapshot {
-        let bed = [
-            ((-0.01, 0.0), 0.001, 0.0),
-            ((0.01, 0.0), 0.001, 0.0),
-            ((0.0, -0.02), 0.0015, 10.0),
-            ((0.0, 0.02), 0.0015, 10.0),
-            ((-0.03, 0.0), 0.002, 20.0),
-            ((0.03, 0.0), 0.002, 20.0),
-        ];
-        tdex_format::Snapshot {
-            index: k,
-            time: 0.5 * f64::from(k),
-            id: (0..6).collect(),
-            pos: bed.iter().map(|&((x, z), _, _)| [x, 0.0, z]).collect(),
-            radius: bed.iter().map(|&(_, r, _)| r).collect(),
-            temp: bed.iter().map(|&(_, _, t)| base + t).collect(),
-            vel: vec![[0.0; 3]; 6],
-        }
-    }
-
     #[test]
     fn a_bed_of_three_sizes_has_its_size_classes_section() {
         // the twin 0.5 K warmer than the reference; the extrapolation within their spread
         // at t2, 1 K too cold at t3
-        let dem: Vec<_> = (0..4)
-            .map(|k| three_classes(k, 300.0 + f64::from(k)))
-            .collect();
-        let twin: Vec<_> = (1..4)
-            .map(|k| three_classes(k, 300.5 + f64::from(k)))
-            .collect();
-        let sizes = classes::SizeClasses::of_run(&dem).expect("three classes");
-        let compared = [three_classes(2, 302.25), three_classes(3, 302.0)]
-            .iter()
-            .map(|s| (classes::ClassState::of(&sizes, s), false))
-            .collect();
-        let c = ClassComparison::new(sizes, &dem, &[twin], compared);
+        let c = classes::synthetic::three_class_comparison();
         let mut d = Document::default();
         size_classes_section(&mut d, &c);
         let md = d.markdown();
