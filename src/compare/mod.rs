@@ -6,10 +6,9 @@ pub mod classes;
 pub mod draws;
 pub mod floor;
 pub mod metrics;
+mod runs;
 pub mod verdict;
 
-use floor::Field;
-use metrics::Cells;
 use serde::Serialize;
 use tdex_format::{Classify, ExtrapolationReader, Fault, FormatError, RecordingReader, Snapshot};
 pub use verdict::Verdict;
@@ -319,166 +318,26 @@ pub fn compare_runs(
     cells: usize,
     seed: u64,
 ) -> Result<Comparison> {
-    let rec_path = recording.path().display().to_string();
-    let dem = recording.snapshots()?;
-    let mut others = recording.twin_snapshots()?;
-    for run in dem_runs {
-        let snaps = run.snapshots()?;
-        check_same_instants((recording, &dem), (run, &snaps))?;
-        others.push(snaps);
-    }
-    // The last snapshot index that is still the recorded run's (0: none, a second DEM run;
-    // None: every one, a path that never jumps): periods 1 … j − 1 before the first jump j
-    // end at t2 … t_j.
-    let recorded_until = match &second {
-        Second::Extrapolation(extrapolation) => extrapolation
-            .info()
-            .roles
-            .first_jump()
-            .and_then(|j| u32::try_from(j).ok()),
-        Second::Dem(_) => Some(0),
-    };
-    let (extra_path, extra, kind, own_groups) = match second {
-        Second::Extrapolation(extrapolation) => {
-            let extra_path = extrapolation.path().display().to_string();
-            let own = &extrapolation.info().recording_info;
-            if own != recording.info() && !same_run(own, recording.info()) {
-                return Err(CompareError::OtherRecording {
-                    extrapolation: extra_path,
-                    recording: rec_path,
-                    names: extrapolation.info().recording.clone(),
-                });
-            }
-            // streamed: an extrapolation of hundreds of periods is never held whole
-            let snaps: SnapshotStream = Box::new(
-                extrapolation
-                    .snapshots_in_order()
-                    .map(|s| s.map_err(CompareError::from)),
-            );
-            (extra_path, snaps, SecondKind::Extrapolation, None)
-        }
-        Second::Dem(twin) => {
-            let snaps = twin.snapshots()?;
-            check_same_instants((recording, &dem), (twin, &snaps))?;
-            // its own hot and cold particles, chosen by the same rule at its own t0
-            let own_groups = snaps
-                .iter()
-                .find(|s| s.index == 0)
-                .and_then(|s| metrics::hot_cold_groups(&metrics::by_id(&s.id, &s.temp)));
-            let snaps: SnapshotStream = Box::new(snaps.into_iter().map(Ok));
-            (
-                twin.path().display().to_string(),
-                snaps,
-                SecondKind::Dem,
-                own_groups,
-            )
-        }
-    };
-    let dem_at = |k: u32| dem.iter().find(|s| s.index == k);
-    let missing = |index| CompareError::MissingSnapshot {
-        path: rec_path.clone(),
-        index,
-    };
-    let t0 = dem_at(0).ok_or_else(|| missing(0))?;
-    let t1 = dem_at(1).ok_or_else(|| missing(1))?;
-    if dem.len() <= 2 {
-        return Err(CompareError::NoReference { path: rec_path });
-    }
-    let reach = t1.radius.iter().copied().fold(0.0, f64::max);
-    let cells_v = Cells::inside_bed(&t1.pos, reach, cells, seed);
-    if cells_v.len() < cells {
-        return Err(CompareError::TooFewSeeds {
-            path: rec_path,
-            drawn: cells_v.len(),
-            cells,
-        });
-    }
-    let groups = metrics::hot_cold_groups(&t0.temp);
-    // An extrapolation's ids are the recording's particles; a second run has its own, and
-    // its own hot and cold particles, chosen by the same rule at its own t0.
-    let extra_groups = match kind {
-        SecondKind::Extrapolation => groups.clone(),
-        SecondKind::Dem => own_groups,
-    };
-    let means_in = |groups: &Option<(Vec<u32>, Vec<u32>)>, temps_by_id: &[f64]| match groups {
-        Some((hot, cold)) => (
-            Some(metrics::group_mean(temps_by_id, hot)),
-            Some(metrics::group_mean(temps_by_id, cold)),
-        ),
-        None => (None, None),
-    };
-    let means = |temps_by_id: &[f64]| means_in(&groups, temps_by_id);
-    let by_id = |s: &Snapshot| metrics::by_id(&s.id, &s.temp);
-    // a further run that starts at t0 has its own hot and cold particles (the same rule at
-    // its own t0); a twin starts at t1 from the reference's state and shares its groups
-    let run_groups: Vec<HotCold> = others
-        .iter()
-        .map(|o| match o.iter().find(|s| s.index == 0) {
-            Some(t0) => metrics::hot_cold_groups(&t0.temp),
-            None => groups.clone(),
-        })
-        .collect();
-    let series = |snaps: &[Snapshot], groups: &HotCold| -> Vec<GroupMeans> {
-        snaps
-            .iter()
-            .map(|s| {
-                let (hot, cold) = means_in(groups, &s.temp);
-                GroupMeans {
-                    k: s.index,
-                    t: s.time,
-                    hot,
-                    cold,
-                    bed: metrics::bed_mean(&s.radius, &s.temp),
-                }
-            })
-            .collect()
-    };
-    let dem_series = series(&dem, &groups);
-    let dem_runs_series: Vec<Vec<GroupMeans>> = others
-        .iter()
-        .zip(&run_groups)
-        .map(|(o, g)| series(o, g))
-        .collect();
-    let wall_temperature = recording.info().walls.iter().find_map(|w| w.temperature);
-    let contrast_kind = match (&groups, wall_temperature) {
-        (Some(_), _) => ContrastKind::HotCold,
-        (None, Some(_)) => ContrastKind::WallBed,
-        (None, None) => ContrastKind::None,
-    };
-
-    // An extrapolation that follows the reference past the twins' parting t_s (several
-    // recorded periods, twins from t1) is measured against the runs that parted from that
-    // shared past at t_s: the twins and any further runs, not the reference
-    // (floor::Departure). One that leaves the reference where the twins do is one more run;
-    // one that leaves it before they part is measured to all, its verdict saying so.
-    let departure = floor::Departure::of(recorded_until, recording.info().twins_from);
-
+    let (dem, others) = runs::read_dem_runs(recording, dem_runs)?;
+    let mut second = runs::SecondField::open(second, recording, &dem)?;
+    let runs = runs::DemRuns::new(recording, (dem, others), cells, seed, second.recorded_until)?;
+    let second_groups = second.groups(&runs.groups);
+    let size_classes = classes::SizeClasses::of_run(&runs.dem);
+    // the second field's class states, one per compared t_k, made as its snapshots stream by
+    let mut class_states: Vec<(classes::ClassState, bool)> = Vec::new();
     // The extrapolated positions are the roles' positions at the end of the recorded period
     // just replayed: always t1's for one recorded period (one cell assignment), t_p's along
     // a recurrence path (assigned anew when they change); a second DEM run moves, so each of
     // its snapshots is assigned anew.
-    //
-    // The second field's snapshots are matched to the DEM's by time, to half a step: the same
-    // index for an extrapolation of this recording, and for one of another recording of the
-    // same run (another period τ, more recorded periods) the reference t_k it lands on; its
-    // snapshots between two reference instants are skipped, and each compared one is measured
-    // over the stretch since the last compared one (t_{k−1} → t_k).
-    let half_step = 0.5 * recording.info().dt;
-    let dem_index_at = |time: f64| {
-        dem.iter()
-            .find(|d| (d.time - time).abs() <= half_step)
-            .map(|d| d.index)
-    };
-    let size_classes = classes::SizeClasses::of_run(&dem);
-    // the second field's class states, one per compared t_k, made as its snapshots stream by
-    let mut class_states: Vec<(classes::ClassState, bool)> = Vec::new();
     let mut role_cells: Option<(Vec<[f64; 3]>, Vec<u32>)> = None;
     let mut periods = Vec::new();
     let mut unreferenced = Vec::new();
+    // The second field's snapshots between two reference instants are skipped, and each
+    // compared one is measured over the stretch since the last compared one.
     let mut previous: Option<(u32, Snapshot)> = None;
-    for after in extra {
+    for after in second.snapshots {
         let after = after?;
-        let Some(k) = dem_index_at(after.time) else {
+        let Some(k) = runs.index_at(after.time) else {
             unreferenced.push(after.index);
             continue;
         };
@@ -487,118 +346,33 @@ pub fn compare_runs(
             continue;
         };
         let (before, after) = (&before, &previous.as_ref().expect("set just above").1);
-        let (Some(dem_before), Some(dem_after)) = (dem_at(k_before), dem_at(k)) else {
+        let (Some(dem_before), Some(dem_after)) = (runs.at(k_before), runs.at(k)) else {
             unreferenced.push(after.index);
             continue;
         };
-        let dem_means = cells_v.means(&dem_after.pos, &dem_after.temp);
         let moved;
-        let extra_cells: &[u32] = match kind {
+        let second_cells: &[u32] = match second.kind {
             SecondKind::Extrapolation => {
                 if role_cells.as_ref().is_none_or(|(pos, _)| *pos != after.pos) {
-                    role_cells = Some((after.pos.clone(), cells_v.assign(&after.pos)));
+                    role_cells = Some((after.pos.clone(), runs.cells.assign(&after.pos)));
                 }
                 &role_cells.as_ref().expect("assigned just above").1
             }
             SecondKind::Dem => {
-                moved = cells_v.assign(&after.pos);
+                moved = runs.cells.assign(&after.pos);
                 &moved
             }
         };
-        let extra_means = metrics::cell_means(extra_cells, &after.temp, cells_v.len());
-        let (eps_abs, cells_used) =
-            metrics::eps_abs(&dem_means, &extra_means).ok_or(CompareError::NoSharedCell { k })?;
-        let (hot_dem, cold_dem) = means(&dem_after.temp);
-        let extra_after = by_id(after);
-        let (hot_extra, cold_extra) = means_in(&extra_groups, &extra_after);
-        let bed_mean_dem = metrics::bed_mean(&dem_after.radius, &dem_after.temp);
-        let scale = match contrast_kind {
-            ContrastKind::HotCold => hot_dem.zip(cold_dem).map(|(h, c)| (h - c).abs()),
-            ContrastKind::WallBed => wall_temperature.map(|w| (w - bed_mean_dem).abs()),
-            ContrastKind::None => None,
-        }
-        .filter(|s| *s > 0.0);
-        // the DEM runs at t_k: the reference, then every further run that reached t_k
-        let (at_k, at_k_groups): (Vec<&Snapshot>, Vec<&HotCold>) = others
-            .iter()
-            .zip(&run_groups)
-            .filter_map(|(o, g)| Some((o.iter().find(|s| s.index == k)?, g)))
-            .unzip();
-        let runs: Vec<Field> = std::iter::once(dem_after)
-            .chain(at_k.iter().copied())
-            .map(|s| Field {
-                pos: &s.pos,
-                temp: &s.temp,
-            })
-            .collect();
-        let floor = floor::floor(&cells_v, &runs, &extra_means, departure);
-        // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
-        // has no snapshot at t1, where it is the reference
-        let floor_energy_error = others
-            .iter()
-            .filter_map(|o| {
-                let twin_after = o.iter().find(|s| s.index == k)?;
-                let twin_before = o
-                    .iter()
-                    .find(|s| s.index == k_before)
-                    .map_or(&dem_before.temp, |s| &s.temp);
-                metrics::energy_error(
-                    &dem_before.temp,
-                    &dem_after.temp,
-                    twin_before,
-                    &twin_after.temp,
-                )
-            })
-            .max_by(|a, b| a.abs().total_cmp(&b.abs()));
-        let within_recording = recorded_until.is_none_or(|until| after.index <= until);
-        periods.push(PeriodComparison {
-            k,
-            t: after.time,
-            eps_abs,
-            cells_used,
-            eps_rel: scale.map(|s| eps_abs / s),
-            energy_error: metrics::energy_error(
-                &dem_before.temp,
-                &dem_after.temp,
-                &by_id(before),
-                &extra_after,
-            ),
-            hot_mean_dem: hot_dem,
-            hot_mean_extra: hot_extra,
-            cold_mean_dem: cold_dem,
-            cold_mean_extra: cold_extra,
-            bed_mean_dem,
-            bed_mean_extra: metrics::bed_mean(&after.radius, &after.temp),
-            contrast: scale,
-            floor_eps_abs: floor.as_ref().map(|f| f.floor_eps_abs),
-            floor_eps_abs_min: floor.as_ref().map(|f| f.floor_eps_abs_min),
-            floor_eps_abs_max: floor.as_ref().map(|f| f.floor_eps_abs_max),
-            floor_eps_rel: floor.as_ref().zip(scale).map(|(f, s)| f.floor_eps_abs / s),
-            eps_abs_to_dem_runs: floor.as_ref().map(|f| f.eps_abs_to_dem_runs),
-            ratio_to_floor: floor.as_ref().and_then(|f| f.ratio_to_floor),
-            dem_runs_ratio_to_others: floor
-                .as_ref()
-                .map_or_else(Vec::new, |f| f.runs_ratio_to_others.clone()),
-            dem_runs_outside_others_range: floor
-                .as_ref()
-                .map_or_else(Vec::new, |f| f.runs_outside_others_range.clone()),
-            floor_energy_error,
-            dem_runs_hot_mean: at_k
-                .iter()
-                .zip(&at_k_groups)
-                .filter_map(|(s, g)| means_in(g, &s.temp).0)
-                .collect(),
-            dem_runs_cold_mean: at_k
-                .iter()
-                .zip(&at_k_groups)
-                .filter_map(|(s, g)| means_in(g, &s.temp).1)
-                .collect(),
-            dem_runs_bed_mean: at_k
-                .iter()
-                .map(|s| metrics::bed_mean(&s.radius, &s.temp))
-                .collect(),
+        let within_recording = second
+            .recorded_until
+            .is_none_or(|until| after.index <= until);
+        periods.push(runs.period(
+            (dem_before, dem_after),
+            (before, after),
+            second_cells,
+            &second_groups,
             within_recording,
-        });
+        )?);
         if let Some(size_classes) = &size_classes {
             let state = classes::ClassState {
                 k,
@@ -609,29 +383,37 @@ pub fn compare_runs(
     }
     if periods.is_empty() {
         return Err(CompareError::NoSharedInstant {
-            second: extra_path,
-            recording: rec_path,
-            last: dem.last().map_or(0, |s| s.index),
+            second: second.path,
+            recording: runs.path,
+            last: runs.dem.last().map_or(0, |s| s.index),
         });
     }
-    let (hot_particles, cold_particles) =
-        groups.as_ref().map_or((0, 0), |(h, c)| (h.len(), c.len()));
-    let verdict = Verdict::of(&periods, 1 + others.len(), departure, contrast_kind);
-    let distinct_radii = classes::too_many_classes(&dem);
-    let size_classes =
-        size_classes.map(|sizes| classes::ClassComparison::new(sizes, &dem, &others, class_states));
+    let (hot_particles, cold_particles) = runs
+        .groups
+        .as_ref()
+        .map_or((0, 0), |(h, c)| (h.len(), c.len()));
+    let verdict = Verdict::of(
+        &periods,
+        1 + runs.others.len(),
+        runs.departure,
+        runs.contrast,
+    );
+    let distinct_radii = classes::too_many_classes(&runs.dem);
+    let (dem_series, dem_runs_series) = runs.series();
+    let size_classes = size_classes
+        .map(|sizes| classes::ClassComparison::new(sizes, &runs.dem, &runs.others, class_states));
     Ok(Comparison {
-        recording: rec_path,
-        extrapolation: extra_path,
-        second: kind,
+        recording: runs.path,
+        extrapolation: second.path,
+        second: second.kind,
         particles: recording.info().particles,
-        cells: cells_v.len(),
+        cells: runs.cells.len(),
         seed,
         hot_particles,
         cold_particles,
-        dem_runs: 1 + others.len(),
-        departure,
-        contrast: contrast_kind,
+        dem_runs: 1 + runs.others.len(),
+        departure: runs.departure,
+        contrast: runs.contrast,
         periods,
         dem_series,
         dem_runs_series,
