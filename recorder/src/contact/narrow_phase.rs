@@ -41,20 +41,15 @@ pub fn scan(
     batch: &mut PairBatch,
     full: &mut impl FnMut(&mut PairBatch),
 ) -> u64 {
-    if period.is_some() {
-        // the seam's nearest image is taken entry by entry; a periodic section is a thin
-        // slice of a kiln, where this scan is a small part of the step
-        return scan_entries(entries, pos, radius, period, touching, batch, full);
-    }
     #[cfg(target_arch = "x86_64")]
     {
         if batch.simd() == crate::simd::Simd::Avx512 {
             // SAFETY: a batch runs with AVX-512 only on a CPU with its F, VL and BW parts
             // (`PairBatch::with_simd`)
-            return unsafe { scan_avx512(entries, pos, radius, touching, batch, full) };
+            return unsafe { scan_avx512(entries, pos, radius, period, touching, batch, full) };
         }
     }
-    scan_entries(entries, pos, radius, None, touching, batch, full)
+    scan_entries(entries, pos, radius, period, touching, batch, full)
 }
 
 /// One entry at a time.
@@ -103,13 +98,15 @@ fn scan_entries(
 /// test gives a mask, and the hits are compressed into the batch (with their old history
 /// indices, expanded from a running count into the lanes that touched before). The
 /// arithmetic is `overlapping`'s, operation for operation (no fused multiply-add), so the
-/// pairs and their `delta` and `r2` are those of [`scan_entries`].
+/// pairs and their `delta` and `r2` are those of [`scan_entries`]; so is the nearest image
+/// of a periodic section ([`nearest_image_lanes`]).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw")]
 fn scan_avx512(
     entries: &ListEntries,
     pos: &[Vec3],
     radius: &[f64],
+    period: Option<AxialPeriod>,
     touch: &mut [bool],
     batch: &mut PairBatch,
     full: &mut impl FnMut(&mut PairBatch),
@@ -154,10 +151,13 @@ fn scan_avx512(
                 assert!(outside == 0, "a list entry of slot {i} names no particle");
                 let j3 = _mm256_add_epi32(_mm256_add_epi32(j, j), j);
                 let zero = _mm512_setzero_pd();
-                let delta: [__m512d; 3] = std::array::from_fn(|a| {
+                let mut delta: [__m512d; 3] = std::array::from_fn(|a| {
                     let xj = _mm512_mask_i32gather_pd::<8>(zero, valid, j3, coordinates.add(a));
                     _mm512_sub_pd(xi[a], xj)
                 });
+                if let Some(period) = period {
+                    delta[1] = nearest_image_lanes(delta[1], period.length);
+                }
                 let rj = _mm512_mask_i32gather_pd::<8>(zero, valid, j, radius.as_ptr());
                 let r2 = _mm512_add_pd(
                     _mm512_add_pd(
@@ -196,6 +196,26 @@ fn scan_avx512(
     touching
 }
 
+/// [`AxialPeriod::nearest_image`] on eight y differences at once, bit for bit:
+/// `Δy − L · round(Δy / L)`. Positions are wrapped into the section at every step, so
+/// `|Δy / L| < 1` and `round` is 1 from ½ up, −1 from −½ down and a zero of `Δy`'s sign
+/// between (the product and the difference then give the scalar's bits, `−0.0` included).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512bw")]
+fn nearest_image_lanes(dy: std::arch::x86_64::__m512d, length: f64) -> std::arch::x86_64::__m512d {
+    use std::arch::x86_64::*;
+    let l = _mm512_set1_pd(length);
+    let q = _mm512_div_pd(dy, l);
+    let up = _mm512_cmp_pd_mask::<_CMP_GE_OQ>(q, _mm512_set1_pd(0.5));
+    let down = _mm512_cmp_pd_mask::<_CMP_LE_OQ>(q, _mm512_set1_pd(-0.5));
+    // a zero with q's sign, then ±1 where q rounds away from it
+    let sign = _mm512_and_si512(_mm512_castpd_si512(q), _mm512_set1_epi64(i64::MIN));
+    let signed_zero = _mm512_castsi512_pd(sign);
+    let k = _mm512_mask_mov_pd(signed_zero, up, _mm512_set1_pd(1.0));
+    let k = _mm512_mask_mov_pd(k, down, _mm512_set1_pd(-1.0));
+    _mm512_sub_pd(dy, _mm512_mul_pd(l, k))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -213,6 +233,7 @@ mod tests {
         entries: &ListEntries,
         pos: &[Vec3],
         radius: &[f64],
+        period: Option<AxialPeriod>,
         touching: &[bool],
     ) -> (Pushed, Vec<bool>, u64) {
         let mut touch = touching.to_vec();
@@ -234,10 +255,14 @@ mod tests {
                     && std::arch::is_x86_feature_detected!("avx512bw")
             );
             // SAFETY: the features were checked just above
-            unsafe { scan_avx512(entries, pos, radius, &mut touch, &mut batch, &mut take) }
+            unsafe {
+                scan_avx512(
+                    entries, pos, radius, period, &mut touch, &mut batch, &mut take,
+                )
+            }
         } else {
             scan_entries(
-                entries, pos, radius, None, &mut touch, &mut batch, &mut take,
+                entries, pos, radius, period, &mut touch, &mut batch, &mut take,
             )
         };
         take(&mut batch);
@@ -265,8 +290,14 @@ mod tests {
             fresh: 99,
         };
         // entries 0, 2 and 3 touched at the last step: old histories 0, 1 and 2
-        let (pushed, touch, count) =
-            outcome(false, &entries, &pos, &radius, &[true, false, true, true]);
+        let (pushed, touch, count) = outcome(
+            false,
+            &entries,
+            &pos,
+            &radius,
+            None,
+            &[true, false, true, true],
+        );
         let old: Vec<u32> = pushed.iter().map(|p| p.2).collect();
         assert_eq!(
             old,
@@ -314,8 +345,8 @@ mod tests {
         let local = partners.len() - first_entry;
         let touching: Vec<bool> = (0..local).map(|_| u() < 0.4).collect();
 
-        let one = outcome(false, &entries, &pos, &radius, &touching);
-        let eight = outcome(true, &entries, &pos, &radius, &touching);
+        let one = outcome(false, &entries, &pos, &radius, None, &touching);
+        let eight = outcome(true, &entries, &pos, &radius, None, &touching);
         assert_eq!(one.0, eight.0, "pushed pairs");
         assert_eq!(one.1, eight.1, "touching flags");
         assert_eq!(one.2, eight.2, "count");
@@ -329,5 +360,88 @@ mod tests {
             "{ended} ended, {kept} kept, {hits} of {local}"
         );
         assert_eq!(one.2 as usize, hits);
+    }
+
+    /// In a periodic section the vector scan takes the same nearest image as the entry by
+    /// entry one, bit for bit: pairs across the seam, differences of exactly half a period
+    /// (which round away from zero) and a difference of −0.0.
+    #[test]
+    #[cfg(target_arch = "x86_64")]
+    fn the_vector_scan_takes_the_nearest_image_of_the_entry_by_entry_scan() {
+        if !std::arch::is_x86_feature_detected!("avx512bw")
+            || !std::arch::is_x86_feature_detected!("avx512vl")
+        {
+            eprintln!("no AVX-512 on this CPU: the vector scan is not used here");
+            return;
+        }
+        let length = 0.04;
+        let period = Some(AxialPeriod { length });
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
+        let mut u = move || uniform(&mut rng);
+        // a thin periodic box: y in [−L/2, L/2), every sphere near some face
+        let n = 300;
+        let mut pos: Vec<Vec3> = (0..n)
+            .map(|_| [0.03 * u(), length * (u() - 0.5), 0.03 * u()])
+            .collect();
+        // exactly half a period apart along y (q = ±0.5), and y = −0.0 against y = +0.0
+        pos[0] = [0.01, 0.01, 0.01];
+        pos[1] = [0.01, -0.01, 0.01];
+        pos[2] = [0.02, -0.0, 0.02];
+        pos[3] = [0.02, 0.0, 0.02];
+        let mut radius: Vec<f64> = (0..n).map(|_| 0.003 + 0.002 * u()).collect();
+        // 0 and 1 touch whichever image: the nearest is the one the scans must agree on
+        (radius[0], radius[1]) = (0.011, 0.011);
+        let (mut offsets, mut partners) = (vec![0u32], vec![]);
+        for i in 0..n {
+            let mut mine: Vec<u32> = match i {
+                0 => vec![1],
+                1 => vec![0],
+                2 => vec![3],
+                3 => vec![2],
+                _ => vec![],
+            };
+            let count = (19.0 * u()) as usize;
+            mine.extend((0..count).map(|_| ((n as f64 * u()) as u32).min(n as u32 - 1)));
+            partners.extend(mine);
+            offsets.push(partners.len() as u32);
+        }
+        let entries = ListEntries {
+            slots: 0..n,
+            offsets: &offsets,
+            partners: &partners,
+            first_entry: 0,
+            fresh: u32::MAX,
+        };
+        let touching: Vec<bool> = (0..partners.len()).map(|_| u() < 0.4).collect();
+        let one = outcome(false, &entries, &pos, &radius, period, &touching);
+        let eight = outcome(true, &entries, &pos, &radius, period, &touching);
+        assert_eq!(one.0, eight.0, "pushed pairs");
+        assert_eq!(one.1, eight.1, "touching flags");
+        assert_eq!(one.2, eight.2, "count");
+        // the seam matters: without the nearest image fewer pairs touch
+        let plain = outcome(false, &entries, &pos, &radius, None, &touching);
+        assert!(
+            plain.2 < one.2,
+            "{} without the seam, {} across it",
+            plain.2,
+            one.2
+        );
+        // half a period apart, the pair takes the image at Δy = −L/2, as round(½) = 1
+        let half = one
+            .0
+            .iter()
+            .find(|p| (p.0, p.1) == (0, 1))
+            .expect("0 and 1 touch");
+        assert_eq!(f64::from_bits(half.3[1]), 0.02 - length);
+        let zero = one
+            .0
+            .iter()
+            .find(|p| (p.0, p.1) == (2, 3))
+            .expect("2 and 3 touch");
+        assert_eq!(
+            zero.3[1],
+            0.0f64.to_bits(),
+            "−0.0 − 0.0 across no seam is +0.0"
+        );
     }
 }
