@@ -14,10 +14,7 @@ use extrapolate::sidecar::StoredPairing;
 use extrapolate::{cache, extrapolate_recording, ExtrapolationRequest, MemoryLimit};
 use proptest::prelude::*;
 use std::path::Path;
-use tdex_format::{
-    AreaEncoding, CollisionRow, RecordingInfo, RecordingReader, RecordingWriter, Snapshot,
-    FORMAT_VERSION,
-};
+use tdex_format::{CollisionRow, RecordingInfo, RecordingReader, RecordingWriter, Snapshot};
 
 /// The radii of the size classes the random beds draw from (a 1 mm to 2.8 mm spread).
 const RADII: [f64; 4] = [0.5e-3, 0.8e-3, 1.1e-3, 1.4e-3];
@@ -255,33 +252,7 @@ fn radius_of(id: usize) -> f64 {
 }
 
 fn info() -> RecordingInfo {
-    RecordingInfo {
-        format_version: FORMAT_VERSION,
-        tool_version: "test".into(),
-        case_toml: String::new(),
-        case_path: String::new(),
-        case_resolved: serde_json::json!({ "seed": 5 }),
-        particles: N as u32,
-        walls: Vec::new(),
-        dt: 1e-5,
-        sample_every: 1,
-        dtc_max_steps: 10,
-        period_steps: TAU,
-        tau: TAU as f64 * 1e-5,
-        t0: 0.0,
-        step_t0: 0,
-        reference_periods: 0,
-        twins: 0,
-        recorded_periods: 1,
-        twins_from: 1,
-        area_encoding: AreaEncoding::Exact,
-        sqrt_area_unit: 0.0,
-        pair_conductivity: 1e5,
-        wall_conductivity: 1e5,
-        density: 2500.0,
-        heat_capacity: 800.0,
-        conductivity: 1.0,
-    }
+    common::recording_info(N, TAU, 1, serde_json::json!({ "seed": 5 }))
 }
 
 /// Snapshot `t_index`: the lattice's sites dealt to the particles in a shuffled order and

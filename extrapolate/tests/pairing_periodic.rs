@@ -16,10 +16,7 @@ use extrapolate::sidecar::StoredPairing;
 use extrapolate::{axial_period, cache, extrapolate_recording, ExtrapolationRequest, MemoryLimit};
 use proptest::prelude::*;
 use std::path::Path;
-use tdex_format::{
-    AreaEncoding, CollisionRow, RecordingInfo, RecordingReader, RecordingWriter, Snapshot,
-    FORMAT_VERSION,
-};
+use tdex_format::{CollisionRow, RecordingInfo, RecordingReader, RecordingWriter, Snapshot};
 
 /// Integer cost of a pair across the seam of period `length`, as the solver defines it:
 /// `Δy` to its nearest image, then `round(|Δ| / unit)`, halves away from zero.
@@ -333,33 +330,7 @@ const TAU: u64 = 1000;
 const LENGTH: f64 = 0.06;
 
 fn info(case_resolved: serde_json::Value) -> RecordingInfo {
-    RecordingInfo {
-        format_version: FORMAT_VERSION,
-        tool_version: "test".into(),
-        case_toml: String::new(),
-        case_path: String::new(),
-        case_resolved,
-        particles: N as u32,
-        walls: Vec::new(),
-        dt: 1e-5,
-        sample_every: 1,
-        dtc_max_steps: 10,
-        period_steps: TAU,
-        tau: TAU as f64 * 1e-5,
-        t0: 0.0,
-        step_t0: 0,
-        reference_periods: 0,
-        twins: 0,
-        recorded_periods: 1,
-        twins_from: 1,
-        area_encoding: AreaEncoding::Exact,
-        sqrt_area_unit: 0.0,
-        pair_conductivity: 1e5,
-        wall_conductivity: 1e5,
-        density: 2500.0,
-        heat_capacity: 800.0,
-        conductivity: 1.0,
-    }
+    common::recording_info(N, TAU, 1, case_resolved)
 }
 
 fn periodic_case() -> serde_json::Value {

@@ -3,6 +3,8 @@
 //! path's seed, heat over 500 periods, `P' = 1` as the paper's method, the refusal of
 //! `P' > P`, streamed against in memory; the axial mirror's images and pairings.
 
+mod common;
+
 use extrapolate::replay::{self, Bodies, Exchanges, Scheme};
 use extrapolate::{
     extrapolate_recording, ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest,
@@ -13,8 +15,8 @@ use rand_xoshiro::Xoshiro256PlusPlus;
 use std::path::{Path, PathBuf};
 use tdex_format::extrapolation::{Roles, Symmetry};
 use tdex_format::{
-    AreaEncoding, CollisionRow, ExtrapolationReader, Fault, RecordingInfo, RecordingReader,
-    RecordingWriter, Snapshot, FORMAT_VERSION,
+    CollisionRow, ExtrapolationReader, Fault, RecordingInfo, RecordingReader, RecordingWriter,
+    Snapshot,
 };
 
 /// Particles of the synthetic bed: a 4 × 4 × 4 lattice.
@@ -42,34 +44,12 @@ impl Draw {
 }
 
 fn info(recorded_periods: u32) -> RecordingInfo {
-    RecordingInfo {
-        format_version: FORMAT_VERSION,
-        tool_version: "test".into(),
-        case_toml: String::new(),
-        case_path: String::new(),
-        case_resolved: serde_json::json!({ "seed": CASE_SEED }),
-        particles: N as u32,
-        walls: Vec::new(),
-        dt: 1e-5,
-        sample_every: 1,
-        dtc_max_steps: 10,
-        period_steps: TAU,
-        tau: TAU as f64 * 1e-5,
-        t0: 0.0,
-        step_t0: 0,
-        reference_periods: 0,
-        twins: 0,
+    common::recording_info(
+        N,
+        TAU,
         recorded_periods,
-        twins_from: 1,
-        area_encoding: AreaEncoding::Exact,
-        sqrt_area_unit: 0.0,
-        // H m = 1e5 W/(K m) × 1e-3 m × up to 1e-4 s: c ≈ 0.02 on equal particles of 1.05 J/K
-        pair_conductivity: 1e5,
-        wall_conductivity: 1e5,
-        density: 2500.0,
-        heat_capacity: 800.0,
-        conductivity: 1.0,
-    }
+        serde_json::json!({ "seed": CASE_SEED }),
+    )
 }
 
 /// Snapshot `t_index`: the lattice's sites dealt to the particles in a shuffled order and

@@ -8,6 +8,7 @@ use std::f64::consts::PI;
 use extrapolate::boundary::BoundaryMaps;
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
+use tdex_format::{AreaEncoding, RecordingInfo, FORMAT_VERSION};
 
 /// Both kinds of fresh boundary maps, pools of `pool` pairings, cells of 3 diameters, the
 /// drift's bins `bin_diameters` long.
@@ -298,4 +299,43 @@ pub fn circulation(
         .collect();
     rng.shuffle(&mut x1);
     x1
+}
+
+/// The info of a synthetic recording of `particles` particles and no walls: `recorded_periods`
+/// periods of `period_steps` steps of 10 µs from t = 0, exact contact areas, conductances of
+/// 1e5 W/(K m) (with contacts of about 1 mm and 1e-4 s, c ≈ 0.02 on particles of 1 J/K), and
+/// `case_resolved` as its case.
+pub fn recording_info(
+    particles: usize,
+    period_steps: u64,
+    recorded_periods: u32,
+    case_resolved: serde_json::Value,
+) -> RecordingInfo {
+    RecordingInfo {
+        format_version: FORMAT_VERSION,
+        tool_version: "test".into(),
+        case_toml: String::new(),
+        case_path: String::new(),
+        case_resolved,
+        particles: particles as u32,
+        walls: Vec::new(),
+        dt: 1e-5,
+        sample_every: 1,
+        dtc_max_steps: 10,
+        period_steps,
+        tau: period_steps as f64 * 1e-5,
+        t0: 0.0,
+        step_t0: 0,
+        reference_periods: 0,
+        twins: 0,
+        recorded_periods,
+        twins_from: 1,
+        area_encoding: AreaEncoding::Exact,
+        sqrt_area_unit: 0.0,
+        pair_conductivity: 1e5,
+        wall_conductivity: 1e5,
+        density: 2500.0,
+        heat_capacity: 800.0,
+        conductivity: 1.0,
+    }
 }
