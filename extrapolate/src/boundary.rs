@@ -120,10 +120,7 @@ impl AxialEnds {
     fn step(self, from: f64, to: f64) -> f64 {
         match self {
             Self::Caps => to - from,
-            Self::Periodic { length } => {
-                let dy = to - from;
-                dy - length * (dy / length).round()
-            }
+            Self::Periodic { length } => pairing::nearest_image(to - from, length),
         }
     }
 

@@ -43,10 +43,15 @@ pub(crate) fn distance(a: &[f64; 3], b: &[f64; 3]) -> f64 {
 #[inline]
 pub(crate) fn periodic_distance(a: &[f64; 3], b: &[f64; 3], length: f64) -> f64 {
     let dx = a[0] - b[0];
-    let mut dy = a[1] - b[1];
-    dy -= length * (dy / length).round();
+    let dy = nearest_image(a[1] - b[1], length);
     let dz = a[2] - b[2];
     (dx * dx + dy * dy + dz * dz).sqrt()
+}
+
+/// An axial difference `dy` taken to its nearest image across a seam of period `length`:
+/// `dy − length · round(dy / length)`, the DEM engine's formula.
+pub(crate) fn nearest_image(dy: f64, length: f64) -> f64 {
+    dy - length * (dy / length).round()
 }
 
 /// `y` moved by whole periods into `[−length/2, length/2)` (unchanged when already there),

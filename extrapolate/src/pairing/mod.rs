@@ -39,7 +39,7 @@ mod sparse_lap;
 use std::time::Instant;
 
 pub use classes::{pair_by_size, respects_classes};
-pub(crate) use cost::wrap;
+pub(crate) use cost::{nearest_image, wrap};
 pub use cycles::{cycle_structure, CycleStructure, SHORT_CYCLE};
 pub use dense::DENSE_LIMIT;
 
