@@ -319,7 +319,7 @@ pub fn compare_runs(
     seed: u64,
 ) -> Result<Comparison> {
     let (dem, others) = runs::read_dem_runs(recording, dem_runs)?;
-    let mut second = runs::SecondField::open(second, recording, &dem)?;
+    let second = runs::SecondField::open(second, recording, &dem)?;
     let runs = runs::DemRuns::new(recording, (dem, others), cells, seed, second.recorded_until)?;
     let second_groups = second.groups(&runs.groups);
     let size_classes = classes::SizeClasses::of_run(&runs.dem);

@@ -89,8 +89,8 @@ impl<'a> SecondField<'a> {
     }
 
     /// The hot and cold particles the second field is judged by, given the reference's.
-    pub fn groups(&mut self, reference: &HotCold) -> HotCold {
-        self.own_groups.take().unwrap_or_else(|| reference.clone())
+    pub fn groups(&self, reference: &HotCold) -> HotCold {
+        self.own_groups.clone().unwrap_or_else(|| reference.clone())
     }
 }
 
