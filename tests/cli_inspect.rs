@@ -268,22 +268,32 @@ fn temperatures_are_refused_in_kelvin() {
     }
 }
 
-/// `tdex inspect run.mcap | head -1`: once the reader has gone, tdex ends quietly on the
-/// broken pipe (SIGPIPE, as any Unix tool), not with a panic on its first print. The read
-/// end is closed before tdex has read the file, so no print can reach the pipe in time.
+/// `tdex inspect --json run.mcap | head -c 1`: once the reader has gone, tdex ends quietly
+/// on the broken pipe (SIGPIPE, as any Unix tool), not with a panic on its next print.
+/// The pipe holds one page and the JSON is several pages, so tdex's write waits until every
+/// read end is closed, then fails. A read end inherited for a moment by a process spawned
+/// beside this test (between its fork and exec) only delays that: the outcome is the same.
 #[test]
 fn a_reader_that_stops_early_ends_inspect_quietly() {
+    use std::os::fd::AsRawFd;
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().unwrap();
     let (run, _) = heated(dir.path());
-    let mut child = Command::new(tdex())
-        .args(["inspect", run.to_str().unwrap()])
-        .stdout(Stdio::piped())
+    let page: i32 = 4096;
+    let json = tdex_ok(&["inspect", "--json", run.to_str().unwrap()]);
+    assert!(json.len() > 2 * page as usize, "{} bytes of JSON", json.len());
+    let (reader, writer) = std::io::pipe().unwrap();
+    // SAFETY: fcntl on a pipe descriptor this test owns; no memory is passed.
+    let capacity = unsafe { libc::fcntl(writer.as_raw_fd(), libc::F_SETPIPE_SZ, page) };
+    assert_eq!(capacity, page, "{}", std::io::Error::last_os_error());
+    drop(reader);
+    let child = Command::new(tdex())
+        .args(["inspect", "--json", run.to_str().unwrap()])
+        .stdout(Stdio::from(writer))
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.is_empty(), "{err}");
