@@ -124,6 +124,62 @@ struct Single {
     dem_outside: f64,
     means_error: f64,
     means_spread: f64,
+    /// Per seat (each DEM run left out for the extrapolation, each run judged against the
+    /// others): whether beyond the others' spread, and the largest error over it.
+    seats: Vec<Seat>,
+    dem_seats: Vec<Seat>,
+}
+
+/// A seat: whether beyond its runs' spread, and its largest error over that spread.
+type Seat = (bool, f64);
+
+/// One group's means at one `t_k`: the extrapolation's, and the DEM runs' (reference first).
+type Means = (f64, Vec<f64>);
+
+/// The group means in the seats, recomputed from the per-`t_k` means of the comparison:
+/// for the extrapolation with DEM run `j` left out, and for each DEM run against the others,
+/// the largest error to the first remaining run over the largest spread of the remaining.
+fn seats_from_periods(v: &Value) -> (Vec<Seat>, Vec<Seat>) {
+    let mut groups: Vec<Means> = Vec::new();
+    for p in v["periods"].as_array().unwrap() {
+        if p["within_recording"].as_bool() == Some(true) {
+            continue;
+        }
+        for g in ["hot", "cold"] {
+            let mut runs = vec![p[format!("{g}_mean_dem")].as_f64().unwrap()];
+            runs.extend(numbers(&p[format!("dem_runs_{g}_mean")]));
+            groups.push((p[format!("{g}_mean_extra")].as_f64().unwrap(), runs));
+        }
+    }
+    let seat = |judged: &dyn Fn(&Means) -> f64, left_out: usize| {
+        let (mut error, mut spread) = (0.0f64, 0.0f64);
+        for g in &groups {
+            let others: Vec<f64> = (0..3).filter(|&i| i != left_out).map(|i| g.1[i]).collect();
+            error = error.max((judged(g) - others[0]).abs());
+            spread = spread.max((others[0] - others[1]).abs());
+        }
+        (error > spread + 1e-9, error / spread)
+    };
+    (
+        (0..3).map(|j| seat(&|g| g.0, j)).collect(),
+        (0..3).map(|i| seat(&|g| g.1[i], i)).collect(),
+    )
+}
+
+/// A seat's figures as the JSON gives them: `[(beyond, error / spread)]`.
+fn seats_from_json(seats: &Value) -> Vec<Seat> {
+    seats
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| {
+            let (e, sp) = (
+                s["error_max"].as_f64().unwrap(),
+                s["spread_max"].as_f64().unwrap(),
+            );
+            (e > sp + 1e-9, e / sp)
+        })
+        .collect()
 }
 
 /// The single comparison's figures; and the DEM runs' shares outside the others' range
@@ -161,6 +217,20 @@ fn single(v: &Value) -> Single {
             "{shares:?} {outside_per_run:?}"
         );
     }
+    let (seats, dem_seats) = seats_from_periods(v);
+    for (json, computed) in [
+        (&verdict["means_in_seat"], &seats),
+        (&verdict["dem_runs_means"], &dem_seats),
+    ] {
+        let given = seats_from_json(json);
+        assert_eq!(given.len(), 3, "{verdict}");
+        for (g, c) in given.iter().zip(computed) {
+            assert!(
+                g.0 == c.0 && close(g.1, c.1),
+                "{given:?} against {computed:?}"
+            );
+        }
+    }
     Single {
         median: verdict["median_ratio"].as_f64().unwrap(),
         outside: verdict["outside_range"].as_array().unwrap().len() as f64 / n,
@@ -168,7 +238,18 @@ fn single(v: &Value) -> Single {
         dem_outside: mean(&shares),
         means_error: verdict["means_error_max"].as_f64().unwrap(),
         means_spread: verdict["means_spread_max"].as_f64().unwrap(),
+        seats,
+        dem_seats,
     }
+}
+
+/// The share of `seats` beyond their runs' spread, and the mean of their error over it.
+fn seat_figures(seats: &[Seat]) -> (f64, f64) {
+    let beyond = seats.iter().filter(|s| s.0).count() as f64 / seats.len() as f64;
+    (
+        beyond,
+        mean(&seats.iter().map(|s| s.1).collect::<Vec<f64>>()),
+    )
 }
 
 /// The pooled JSON object against the single comparisons it pools: every mean and
@@ -219,6 +300,22 @@ fn assert_pooled(draws: &Value, singles: &[Single]) {
         draws["means_spread_beside"].as_f64(),
         Some(worst.means_spread)
     );
+    // the means in a DEM run's seat, the extrapolation's beside a DEM run's
+    for (key, figure) in [
+        (
+            "means_outside_share_in_seat",
+            (|s: &Single| seat_figures(&s.seats).0) as fn(&Single) -> f64,
+        ),
+        ("dem_runs_means_outside_share", |s| {
+            seat_figures(&s.dem_seats).0
+        }),
+        ("means_error_to_spread", |s| seat_figures(&s.seats).1),
+        ("dem_runs_means_error_to_spread", |s| {
+            seat_figures(&s.dem_seats).1
+        }),
+    ] {
+        assert_mean_se(&draws[key], mean_se(&col(figure)), key);
+    }
     let passes = x.0 <= bar && xo.0 <= outside_bar + 1e-12 && failing == 0;
     assert_eq!(draws["passes"].as_bool(), Some(passes), "{draws}");
     let text = draws["text"].as_str().unwrap();

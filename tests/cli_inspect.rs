@@ -282,7 +282,11 @@ fn a_reader_that_stops_early_ends_inspect_quietly() {
     let (run, _) = heated(dir.path());
     let page: i32 = 4096;
     let json = tdex_ok(&["inspect", "--json", run.to_str().unwrap()]);
-    assert!(json.len() > 2 * page as usize, "{} bytes of JSON", json.len());
+    assert!(
+        json.len() > 2 * page as usize,
+        "{} bytes of JSON",
+        json.len()
+    );
     let (reader, writer) = std::io::pipe().unwrap();
     // SAFETY: fcntl on a pipe descriptor this test owns; no memory is passed.
     let capacity = unsafe { libc::fcntl(writer.as_raw_fd(), libc::F_SETPIPE_SZ, page) };

@@ -9,7 +9,7 @@
 //! the same seat, each with its standard error over the draws, and the share of compared
 //! `t_k` outside the DEM runs' range for both.
 
-use super::verdict::{kelvin, num};
+use super::verdict::{kelvin, num, SeatMeans, MEANS_TOLERANCE};
 use super::{CompareError, Comparison, ContrastKind};
 use serde::Serialize;
 use tdex_format::RecordingInfo;
@@ -30,11 +30,6 @@ pub const STANDARD_ERRORS: f64 = 2.0;
 /// How much larger (as a share of the compared `t_k`, 10 percentage points) the
 /// extrapolation's share outside the DEM runs' range may be than the DEM runs' own.
 pub const OUTSIDE_SHARE_MARGIN: f64 = 0.10;
-
-/// Room for float noise when a group (bed) mean error is set against the DEM runs'
-/// spread, K: a conserved bed mean differs between runs only by rounding, and so does its
-/// error, which must then not fail on the last bits.
-const MEANS_TOLERANCE: f64 = 1e-9;
 
 /// Room for float noise when shares (whole counts of `t_k` over the compared ones) are set
 /// against their bar, so that a share exactly on the bar counts as on it.
@@ -85,6 +80,14 @@ pub struct Draw {
     /// the compared `t_k`, and the largest difference between two DEM runs' means there, K.
     pub means_error_max: f64,
     pub means_spread_max: f64,
+    /// The means in a DEM run's seat ([`super::Verdict::means_in_seat`]): the share of the
+    /// seats (0 to 1) where the extrapolation, and where a DEM run, strays beyond the
+    /// others' spread, and how far: the mean of the largest error over the largest spread
+    /// (null where a spread is only rounding, as of a conserved bed mean).
+    pub means_outside_share_in_seat: f64,
+    pub dem_runs_means_outside_share: f64,
+    pub means_error_to_spread: Option<f64>,
+    pub dem_runs_means_error_to_spread: Option<f64>,
     /// Whether the means are the hot and cold group means (else the bed mean).
     #[serde(skip)]
     pub groups: bool,
@@ -109,6 +112,18 @@ impl Draw {
         let mean = |values: &[f64]| {
             (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
         };
+        // the share of seats beyond their runs' spread, and the mean error over spread
+        let outside_share = |seats: &[SeatMeans]| {
+            (!seats.is_empty())
+                .then(|| seats.iter().filter(|s| s.outside()).count() as f64 / seats.len() as f64)
+        };
+        let error_to_spread = |seats: &[SeatMeans]| {
+            seats
+                .iter()
+                .map(|s| (s.spread_max > MEANS_TOLERANCE).then_some(s.error_max / s.spread_max))
+                .collect::<Option<Vec<f64>>>()
+                .and_then(|r| mean(&r))
+        };
         Ok(Draw {
             recording: c.recording.clone(),
             extrapolation: c.extrapolation.clone(),
@@ -119,6 +134,11 @@ impl Draw {
             dem_runs_outside_share: mean(&v.dem_runs_outside_share).ok_or_else(not_judged)?,
             means_error_max: v.means_error_max.ok_or_else(not_judged)?,
             means_spread_max: v.means_spread_max.ok_or_else(not_judged)?,
+            means_outside_share_in_seat: outside_share(&v.means_in_seat).ok_or_else(not_judged)?,
+            dem_runs_means_outside_share: outside_share(&v.dem_runs_means)
+                .ok_or_else(not_judged)?,
+            means_error_to_spread: error_to_spread(&v.means_in_seat),
+            dem_runs_means_error_to_spread: error_to_spread(&v.dem_runs_means),
             groups: c.contrast == ContrastKind::HotCold,
         })
     }
@@ -158,6 +178,14 @@ pub struct Draws {
     pub means_outside_spread_draws: usize,
     pub means_error_max: f64,
     pub means_spread_beside: f64,
+    /// The means in a DEM run's seat over the draws, the extrapolation's beside a DEM
+    /// run's: how often a genuine run strays beyond the others' spread where the
+    /// extrapolation must not, and how far (the largest error over the largest spread; null
+    /// unless every draw has one).
+    pub means_outside_share_in_seat: MeanSe,
+    pub dem_runs_means_outside_share: MeanSe,
+    pub means_error_to_spread: Option<MeanSe>,
+    pub dem_runs_means_error_to_spread: Option<MeanSe>,
     /// Each draw's figures, in the order given.
     pub each: Vec<Draw>,
     /// The judgement in words.
@@ -199,6 +227,14 @@ impl Draws {
         let (means_error_max, means_spread_beside) =
             (worst.means_error_max, worst.means_spread_max);
         let means_within_spread = means_outside_spread_draws == 0;
+        let means_outside_share_in_seat = over(|d| d.means_outside_share_in_seat);
+        let dem_runs_means_outside_share = over(|d| d.dem_runs_means_outside_share);
+        let over_some = |figure: fn(&Draw) -> Option<f64>| {
+            let values = each.iter().map(figure).collect::<Option<Vec<f64>>>()?;
+            MeanSe::of(&values)
+        };
+        let means_error_to_spread = over_some(|d| d.means_error_to_spread);
+        let dem_runs_means_error_to_spread = over_some(|d| d.dem_runs_means_error_to_spread);
         let passes = median_ratio_within && outside_share_within && means_within_spread;
 
         let n = each.len();
@@ -243,10 +279,23 @@ impl Draws {
                  {means_outside_spread_draws} of the {n} draws"
             )
         };
+        let stray = if worst.groups { "stray" } else { "strays" };
+        let how_far = match (means_error_to_spread, dem_runs_means_error_to_spread) {
+            (Some(x), Some(dem)) => format!(
+                " (largest error {} times their spread against {})",
+                plus_minus(x),
+                plus_minus(dem)
+            ),
+            _ => String::new(),
+        };
         let means_words = format!(
-            "{what} {where_} (the largest error {}, in a draw whose DEM runs differ by up to {})",
+            "{what} {where_} (the largest error {}, in a draw whose DEM runs differ by up to \
+             {}); in a DEM run's seat, against the other runs, the extrapolation's {what} \
+             {stray} beyond their spread in {} of the seats against {} for a DEM run{how_far}",
             kelvin(means_error_max),
             kelvin(means_spread_beside),
+            percent_plus_minus(means_outside_share_in_seat),
+            percent_plus_minus(dem_runs_means_outside_share),
         );
         let text = format!(
             "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
@@ -268,6 +317,10 @@ impl Draws {
             means_outside_spread_draws,
             means_error_max,
             means_spread_beside,
+            means_outside_share_in_seat,
+            dem_runs_means_outside_share,
+            means_error_to_spread,
+            dem_runs_means_error_to_spread,
             each,
             text,
         })
@@ -276,21 +329,38 @@ impl Draws {
     /// The pooled figures as a small table: the extrapolation beside a DEM run in the seat.
     pub fn table(&self) -> String {
         let mut s = format!(
-            "{:<34} {:>16} {:>20}\n",
+            "{:<40} {:>16} {:>20}\n",
             "over the draws (mean ± SE)", "extrapolation", "DEM run in the seat"
         );
         s += &format!(
-            "{:<34} {:>16} {:>20}\n",
+            "{:<40} {:>16} {:>20}\n",
             "median ratio",
             plus_minus(self.median_ratio),
             plus_minus(self.dem_runs_median_ratio)
         );
         s += &format!(
-            "{:<34} {:>16} {:>20}\n",
+            "{:<40} {:>16} {:>20}\n",
             "beyond the DEM runs' range (% t_k)",
             percent_plus_minus(self.outside_share),
             percent_plus_minus(self.dem_runs_outside_share)
         );
+        s += &format!(
+            "{:<40} {:>16} {:>20}\n",
+            "means beyond the others' spread (% seats)",
+            percent_plus_minus(self.means_outside_share_in_seat),
+            percent_plus_minus(self.dem_runs_means_outside_share)
+        );
+        if let (Some(x), Some(dem)) = (
+            self.means_error_to_spread,
+            self.dem_runs_means_error_to_spread,
+        ) {
+            s += &format!(
+                "{:<40} {:>16} {:>20}\n",
+                "means: largest error / others' spread",
+                plus_minus(x),
+                plus_minus(dem)
+            );
+        }
         s
     }
 }
@@ -381,6 +451,10 @@ mod tests {
             dem_runs_outside_share: dem_outside,
             means_error_max: 0.01,
             means_spread_max: 0.02,
+            means_outside_share_in_seat: 0.0,
+            dem_runs_means_outside_share: 0.0,
+            means_error_to_spread: Some(0.5),
+            dem_runs_means_error_to_spread: Some(0.5),
             groups: true,
         }
     }
@@ -485,14 +559,33 @@ mod tests {
         assert!(
             within.text.ends_with(
                 "group means within the DEM runs' spread at every compared t_k of every draw \
-                 (the largest error 0.0100 K, in a draw whose DEM runs differ by up to 0.0200 K)"
+                 (the largest error 0.0100 K, in a draw whose DEM runs differ by up to \
+                 0.0200 K); in a DEM run's seat, against the other runs, the extrapolation's \
+                 group means stray beyond their spread in 0 ± 0 % of the seats against 0 ± 0 % \
+                 for a DEM run (largest error 0.50 ± 0.00 times their spread against 0.50 ± \
+                 0.00)"
             ),
             "{}",
             within.text
         );
         draws[1].means_error_max = 0.15;
         draws[1].means_spread_max = 0.03;
+        draws[1].means_error_to_spread = Some(5.0);
+        // one run of three in the seat beyond the others' spread in the first draw, two in
+        // the second: 0.333, 0.667, 0 (mean 1/3, SE 0.192)
+        draws[0].dem_runs_means_outside_share = 1.0 / 3.0;
+        draws[1].dem_runs_means_outside_share = 2.0 / 3.0;
+        draws[1].means_outside_share_in_seat = 1.0;
         let outside = Draws::pool(draws.clone()).unwrap();
+        assert!((outside.means_outside_share_in_seat.mean - 1.0 / 3.0).abs() < 1e-15);
+        assert!((outside.dem_runs_means_outside_share.mean - 1.0 / 3.0).abs() < 1e-15);
+        assert!(
+            outside
+                .table()
+                .contains("means beyond the others' spread (% seats)"),
+            "{}",
+            outside.table()
+        );
         assert!(!outside.means_within_spread && !outside.passes);
         assert_eq!(outside.means_outside_spread_draws, 1);
         assert_eq!(
@@ -503,19 +596,26 @@ mod tests {
             outside.text.contains(
                 "group means beyond the DEM runs' spread at some compared t_k in 1 of the 3 \
                  draws (the largest error 0.150 K, in a draw whose DEM runs differ by up to \
-                 0.0300 K)"
+                 0.0300 K); in a DEM run's seat, against the other runs, the extrapolation's \
+                 group means stray beyond their spread in 33 ± 33 % of the seats against 33 ± \
+                 19 % for a DEM run (largest error 2.00 ± 1.50 times their spread against 0.50 \
+                 ± 0.00)"
             ),
             "{}",
             outside.text
         );
-        // a conserved bed mean: error and spread both rounding, which does not fail
+        // a conserved bed mean: error and spread both rounding, which does not fail, and
+        // whose ratio is not given
         for d in &mut draws {
             d.groups = false;
             d.means_error_max = 3e-14;
             d.means_spread_max = 1e-14;
+            d.means_error_to_spread = None;
         }
         let conserved = Draws::pool(draws).unwrap();
         assert!(conserved.means_within_spread, "{}", conserved.text);
+        assert_eq!(conserved.means_error_to_spread, None);
+        assert!(!conserved.text.contains("times their spread"));
         assert!(
             conserved.text.contains("bed mean within"),
             "{}",

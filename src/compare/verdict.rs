@@ -6,6 +6,28 @@ use super::floor::{median, Departure};
 use super::{ContrastKind, PeriodComparison};
 use serde::Serialize;
 
+/// Room for float noise when a group (bed) mean error is set against the DEM runs'
+/// spread, K: a conserved bed mean differs between runs only by rounding, and so does its
+/// error, which must then not fail on the last bits.
+pub(crate) const MEANS_TOLERANCE: f64 = 1e-9;
+
+/// A field judged on the group (bed) means against some of the DEM runs, K.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SeatMeans {
+    /// Its largest error against the first of those runs (the reference, or without it
+    /// the first further run) over the compared `t_k`.
+    pub error_max: f64,
+    /// The largest difference between two of those runs' means there.
+    pub spread_max: f64,
+}
+
+impl SeatMeans {
+    /// Whether the field strays beyond those runs' spread.
+    pub fn outside(&self) -> bool {
+        self.error_max > self.spread_max + MEANS_TOLERANCE
+    }
+}
+
 /// The judgement of a comparison.
 #[derive(Debug, Clone, Serialize)]
 pub struct Verdict {
@@ -41,6 +63,16 @@ pub struct Verdict {
     /// `dem_runs_median_ratio`, and empty (left out of the JSON) when it is.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_outside_share: Vec<f64>,
+    /// With three or more runs, the group (bed) means in the seat of a DEM run: the second
+    /// field judged against the runs without each one in turn (in the runs' order), and
+    /// each DEM run judged against the others the same way. Both against the same number
+    /// of runs, since a spread widens with the runs in it: how often, and how far, a genuine
+    /// run strays where the second field does. Empty with fewer runs, and then left out of
+    /// the JSON.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub means_in_seat: Vec<SeatMeans>,
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dem_runs_means: Vec<SeatMeans>,
     /// The verdict in words.
     pub text: String,
 }
@@ -170,6 +202,7 @@ impl Verdict {
         // DEM runs' own spread
         let groups = contrast == ContrastKind::HotCold;
         let (error, spread) = means_error_and_spread(&periods, groups);
+        let (means_in_seat, dem_runs_means) = means_in_seats(&periods, groups, dem_runs);
         let median_ratio = median(&ratios);
         let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs);
         let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
@@ -317,6 +350,8 @@ impl Verdict {
             means_spread_max: spread,
             dem_runs_median_ratio,
             dem_runs_outside_share,
+            means_in_seat,
+            dem_runs_means,
             text,
         }
     }
@@ -393,6 +428,36 @@ fn runs_outside_shares(
         .collect()
 }
 
+/// One group's (the bed's, for a bed without groups) means at one `t_k`: the second
+/// field's, and the DEM runs' (the reference first, then the further runs).
+type GroupMeans = (f64, Vec<f64>);
+
+/// Per compared period, each group's means.
+fn group_means(p: &PeriodComparison, groups: bool) -> Vec<GroupMeans> {
+    let with_reference = |dem: f64, runs: &[f64]| [&[dem][..], runs].concat();
+    if groups {
+        [
+            (p.hot_mean_extra, p.hot_mean_dem, &p.dem_runs_hot_mean),
+            (p.cold_mean_extra, p.cold_mean_dem, &p.dem_runs_cold_mean),
+        ]
+        .into_iter()
+        .filter_map(|(e, d, runs)| Some((e?, with_reference(d?, runs))))
+        .collect()
+    } else {
+        vec![(
+            p.bed_mean_extra,
+            with_reference(p.bed_mean_dem, &p.dem_runs_bed_mean),
+        )]
+    }
+}
+
+/// The largest difference between two of `means`.
+fn spread_of(means: impl Iterator<Item = f64> + Clone) -> f64 {
+    let hi = means.clone().fold(f64::NEG_INFINITY, f64::max);
+    let lo = means.fold(f64::INFINITY, f64::min);
+    hi - lo
+}
+
 /// The largest error of the group means (the bed mean for a bed without groups) against the
 /// DEM's over `periods`, and the largest spread of the DEM runs' own (`None` without runs).
 fn means_error_and_spread(
@@ -402,28 +467,56 @@ fn means_error_and_spread(
     let mut error: Option<f64> = None;
     let mut spread: Option<f64> = None;
     for p in periods {
-        let pairs: Vec<(f64, f64, &Vec<f64>)> = if groups {
-            [
-                (p.hot_mean_extra, p.hot_mean_dem, &p.dem_runs_hot_mean),
-                (p.cold_mean_extra, p.cold_mean_dem, &p.dem_runs_cold_mean),
-            ]
-            .into_iter()
-            .filter_map(|(e, d, runs)| Some((e?, d?, runs)))
-            .collect()
-        } else {
-            vec![(p.bed_mean_extra, p.bed_mean_dem, &p.dem_runs_bed_mean)]
-        };
-        for (extra, dem, runs) in pairs {
-            error = Some(error.unwrap_or(0.0).max((extra - dem).abs()));
-            if !runs.is_empty() {
-                let all = runs.iter().copied().chain([dem]);
-                let hi = all.clone().fold(f64::NEG_INFINITY, f64::max);
-                let lo = all.fold(f64::INFINITY, f64::min);
-                spread = Some(spread.unwrap_or(0.0).max(hi - lo));
+        for (extra, runs) in group_means(p, groups) {
+            error = Some(error.unwrap_or(0.0).max((extra - runs[0]).abs()));
+            if runs.len() > 1 {
+                spread = Some(spread.unwrap_or(0.0).max(spread_of(runs.iter().copied())));
             }
         }
     }
     (error, spread)
+}
+
+/// The means in the seats, with `dem_runs` ≥ 3 runs: the second field judged against the
+/// runs without run `j` (for each `j`, in order), then each run `i` judged against the
+/// others, both as [`SeatMeans`] against two or more runs of the same count, so that a
+/// spread of as many runs stands beside each (the range of three runs is on average half
+/// as wide again as that of two). Both empty with fewer runs, or where a period lacks a
+/// run's means.
+fn means_in_seats(
+    periods: &[&PeriodComparison],
+    groups: bool,
+    dem_runs: usize,
+) -> (Vec<SeatMeans>, Vec<SeatMeans>) {
+    let means: Vec<GroupMeans> = periods
+        .iter()
+        .flat_map(|p| group_means(p, groups))
+        .collect();
+    if dem_runs < 3 || means.is_empty() || means.iter().any(|(_, runs)| runs.len() != dem_runs) {
+        return (Vec::new(), Vec::new());
+    }
+    // `judged` against the runs but `left_out`, over every period and group
+    let seat = |judged: &dyn Fn(&GroupMeans) -> f64, left_out: usize| {
+        let (mut error, mut spread) = (0.0_f64, 0.0_f64);
+        for at in &means {
+            let others = || {
+                at.1.iter()
+                    .enumerate()
+                    .filter(move |(i, _)| *i != left_out)
+                    .map(|(_, m)| *m)
+            };
+            let first = others().next().expect("two others or more");
+            error = error.max((judged(at) - first).abs());
+            spread = spread.max(spread_of(others()));
+        }
+        SeatMeans {
+            error_max: error,
+            spread_max: spread,
+        }
+    };
+    let second_field = (0..dem_runs).map(|j| seat(&|at| at.0, j)).collect();
+    let runs = (0..dem_runs).map(|i| seat(&|at| at.1[i], i)).collect();
+    (second_field, runs)
 }
 
 /// The yardstick beside the median: how the DEM runs score judged the same way against the
@@ -647,6 +740,53 @@ mod tests {
         assert!(v.dem_runs_median_ratio.is_empty());
         assert!(v.dem_runs_outside_share.is_empty());
         assert!(!v.text.contains("each DEM run"), "{}", v.text);
+    }
+
+    /// Each DEM run is judged on the means as the second field is: its error against the
+    /// first of the others beside the others' own spread. A run far from the two others
+    /// misses; the two close ones do not, and fewer than three runs give nothing.
+    #[test]
+    fn each_dem_run_is_judged_on_the_means_in_the_seat() {
+        let mut p = period(2, 1.0, 1.5);
+        p.dem_runs_bed_mean = vec![305.1, 305.5];
+        let mut q = period(3, 1.0, 1.5);
+        q.dem_runs_bed_mean = vec![305.05, 305.45];
+        let periods = [p.clone(), q];
+        let v = Verdict::of(&periods, 3, Departure::WithTheTwins, ContrastKind::WallBed);
+        // the reference: 0.1 from the first twin, the twins 0.4 apart; the first twin 0.1
+        // from the reference, beside 0.5; the second 0.5 from the reference, beside 0.1
+        let outside = |v: &Verdict| -> Vec<bool> {
+            v.dem_runs_means.iter().map(SeatMeans::outside).collect()
+        };
+        assert_eq!(outside(&v), vec![false, false, true]);
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        let seat = v.dem_runs_means[2];
+        assert!(
+            close(seat.error_max, 0.5) && close(seat.spread_max, 0.1),
+            "{seat:?}"
+        );
+        // the extrapolation (305.0 throughout) without the reference: 0.1 from the first
+        // twin beside their 0.4; without a twin: 0 from the reference, beside 0.5 and 0.1
+        let errors: Vec<(f64, f64)> = v
+            .means_in_seat
+            .iter()
+            .map(|s| (s.error_max, s.spread_max))
+            .collect();
+        for (got, want) in errors.iter().zip([(0.1, 0.4), (0.0, 0.5), (0.0, 0.1)]) {
+            assert!(close(got.0, want.0) && close(got.1, want.1), "{errors:?}");
+        }
+        // the groups' means: the hot twin 0.04 from the reference, the cold 0.01
+        p.dem_runs_hot_mean = vec![310.04, 310.5];
+        p.dem_runs_cold_mean = vec![300.01, 300.02];
+        let v = Verdict::of(
+            &[p.clone()],
+            3,
+            Departure::WithTheTwins,
+            ContrastKind::HotCold,
+        );
+        assert_eq!(outside(&v), vec![false, false, true]);
+        let v = Verdict::of(&[p], 2, Departure::WithTheTwins, ContrastKind::HotCold);
+        assert!(v.dem_runs_means.is_empty() && v.means_in_seat.is_empty());
     }
 
     /// Twins that parted after the extrapolation left the reference: the judgement stands

@@ -506,6 +506,44 @@ fn pooled_table(s: &HorizonStudy) -> String {
             if d.passes { "yes" } else { "no" },
         );
     }
+    t += &format!(
+        "\nthe {} means over the draws (draws beyond: where they stray beyond the DEM runs' \
+         spread at some t_k, which fails the pooled verdict; then in a DEM run's seat, against \
+         the other runs, beside a DEM run judged the same way: the share of seats where they \
+         stray beyond those runs' spread, and their largest error over that spread):\n",
+        if s.pooled
+            .first()
+            .and_then(|r| r.draws.each.first())
+            .is_some_and(|d| d.groups)
+        {
+            "group"
+        } else {
+            "bed"
+        }
+    );
+    t += &format!(
+        "{:<w$} {:>12} {:>14} {:>16} {:>16} {:>22}\n",
+        "run",
+        "draws beyond",
+        "seats beyond",
+        "DEM run: beyond",
+        "error / spread",
+        "DEM run: error / spread"
+    );
+    let or_dash = |m: Option<draws::MeanSe>| m.map_or("-".to_string(), draws::plus_minus);
+    for r in &s.pooled {
+        let d = &r.draws;
+        t += &format!(
+            "{:<w$} {:>12} {:>14} {:>16} {:>16} {:>22}\n",
+            r.label(),
+            format!("{} of {}", d.means_outside_spread_draws, d.draws),
+            draws::percent_plus_minus(d.means_outside_share_in_seat),
+            draws::percent_plus_minus(d.dem_runs_means_outside_share),
+            or_dash(d.means_error_to_spread),
+            or_dash(d.dem_runs_means_error_to_spread),
+        );
+    }
+    t.push('\n');
     for r in &s.pooled {
         t += &format!("{} over the draws: {}\n", r.label(), r.draws.text);
     }
@@ -537,7 +575,9 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
              runs' medians); it passes when that mean is at most the DEM runs' plus two \
              standard errors of the difference, the share of t_k beyond the DEM runs' range at \
              most theirs plus 10 points, and the group (or bed) means within the DEM runs' \
-             spread in every draw. The plot of the means shows the first draw.",
+             spread in every draw (beside it, the means in a DEM run's seat: the extrapolation \
+             and each DEM run judged against the other runs, so against as many runs). The plot \
+             of the means shows the first draw.",
             s.draws.len(),
             s.draws
                 .iter()
