@@ -236,74 +236,8 @@ impl Draws {
         let means_error_to_spread = over_some(|d| d.means_error_to_spread);
         let dem_runs_means_error_to_spread = over_some(|d| d.dem_runs_means_error_to_spread);
         let passes = median_ratio_within && outside_share_within && means_within_spread;
-
-        let n = each.len();
-        let ratio_words = format!(
-            "mean median ratio {} against {} for a DEM run judged in the same seat, {} the bar \
-             of {} (theirs plus two standard errors of the difference)",
-            plus_minus(median_ratio),
-            plus_minus(dem_runs_median_ratio),
-            if median_ratio_within {
-                "within"
-            } else {
-                "above"
-            },
-            fixed(median_ratio_bar, decimals(difference_se, 2)),
-        );
-        let outside_words = format!(
-            "farther than the two farthest DEM runs at {} of the compared t_k against {} for a \
-             DEM run in the seat, {} the bar of {} % (theirs plus {} points)",
-            percent_plus_minus(outside_share),
-            percent_plus_minus(dem_runs_outside_share),
-            if outside_share_within {
-                "within"
-            } else {
-                "above"
-            },
-            fixed(
-                100.0 * outside_share_bar,
-                decimals(100.0 * dem_runs_outside_share.standard_error, 0)
-            ),
-            num(100.0 * OUTSIDE_SHARE_MARGIN),
-        );
-        let what = if worst.groups {
-            "group means"
-        } else {
-            "bed mean"
-        };
-        let where_ = if means_within_spread {
-            "within the DEM runs' spread at every compared t_k of every draw".to_string()
-        } else {
-            format!(
-                "beyond the DEM runs' spread at some compared t_k in \
-                 {means_outside_spread_draws} of the {n} draws"
-            )
-        };
-        let stray = if worst.groups { "stray" } else { "strays" };
-        let how_far = match (means_error_to_spread, dem_runs_means_error_to_spread) {
-            (Some(x), Some(dem)) => format!(
-                " (largest error {} times their spread against {})",
-                plus_minus(x),
-                plus_minus(dem)
-            ),
-            _ => String::new(),
-        };
-        let means_words = format!(
-            "{what} {where_} (the largest error {}, in a draw whose DEM runs differ by up to \
-             {}); in a DEM run's seat, against the other runs, the extrapolation's {what} \
-             {stray} beyond their spread in {} of the seats against {} for a DEM run{how_far}",
-            kelvin(means_error_max),
-            kelvin(means_spread_beside),
-            percent_plus_minus(means_outside_share_in_seat),
-            percent_plus_minus(dem_runs_means_outside_share),
-        );
-        let text = format!(
-            "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
-             {means_words}",
-            if passes { "passes" } else { "does not pass" }
-        );
-        Ok(Draws {
-            draws: n,
+        let mut pooled = Draws {
+            draws: each.len(),
             passes,
             median_ratio,
             dem_runs_median_ratio,
@@ -322,8 +256,87 @@ impl Draws {
             means_error_to_spread,
             dem_runs_means_error_to_spread,
             each,
-            text,
-        })
+            text: String::new(),
+        };
+        pooled.text = pooled.words();
+        Ok(pooled)
+    }
+
+    /// The pooled judgement in words, from its figures.
+    fn words(&self) -> String {
+        let groups = self.each.first().is_some_and(|d| d.groups);
+        let n = self.draws;
+        let difference_se = self
+            .median_ratio
+            .standard_error
+            .hypot(self.dem_runs_median_ratio.standard_error);
+        let ratio_words = format!(
+            "mean median ratio {} against {} for a DEM run judged in the same seat, {} the bar \
+             of {} (theirs plus two standard errors of the difference)",
+            plus_minus(self.median_ratio),
+            plus_minus(self.dem_runs_median_ratio),
+            if self.median_ratio_within {
+                "within"
+            } else {
+                "above"
+            },
+            fixed(self.median_ratio_bar, decimals(difference_se, 2)),
+        );
+        let outside_words = format!(
+            "farther than the two farthest DEM runs at {} of the compared t_k against {} for a \
+             DEM run in the seat, {} the bar of {} % (theirs plus {} points)",
+            percent_plus_minus(self.outside_share),
+            percent_plus_minus(self.dem_runs_outside_share),
+            if self.outside_share_within {
+                "within"
+            } else {
+                "above"
+            },
+            fixed(
+                100.0 * self.outside_share_bar,
+                decimals(100.0 * self.dem_runs_outside_share.standard_error, 0)
+            ),
+            num(100.0 * OUTSIDE_SHARE_MARGIN),
+        );
+        let what = if groups { "group means" } else { "bed mean" };
+        let where_ = if self.means_within_spread {
+            "within the DEM runs' spread at every compared t_k of every draw".to_string()
+        } else {
+            format!(
+                "beyond the DEM runs' spread at some compared t_k in {} of the {n} draws",
+                self.means_outside_spread_draws
+            )
+        };
+        let stray = if groups { "stray" } else { "strays" };
+        let how_far = match (
+            self.means_error_to_spread,
+            self.dem_runs_means_error_to_spread,
+        ) {
+            (Some(x), Some(dem)) => format!(
+                " (largest error {} times their spread against {})",
+                plus_minus(x),
+                plus_minus(dem)
+            ),
+            _ => String::new(),
+        };
+        let means_words = format!(
+            "{what} {where_} (the largest error {}, in a draw whose DEM runs differ by up to \
+             {}); in a DEM run's seat, against the other runs, the extrapolation's {what} \
+             {stray} beyond their spread in {} of the seats against {} for a DEM run{how_far}",
+            kelvin(self.means_error_max),
+            kelvin(self.means_spread_beside),
+            percent_plus_minus(self.means_outside_share_in_seat),
+            percent_plus_minus(self.dem_runs_means_outside_share),
+        );
+        format!(
+            "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
+             {means_words}",
+            if self.passes {
+                "passes"
+            } else {
+                "does not pass"
+            }
+        )
     }
 
     /// The pooled figures as a small table: the extrapolation beside a DEM run in the seat.
