@@ -28,6 +28,18 @@ impl SeatMeans {
     }
 }
 
+/// What a verdict's words need beside its figures.
+struct Setting {
+    dem_runs: usize,
+    departure: Departure,
+    /// The means are the hot and cold groups' (else the bed's).
+    groups: bool,
+    /// Whether any compared `t_k` has a floor (two DEM runs or more).
+    floors: bool,
+    /// The compared periods past the recorded run, which `t_k` lists are counted against.
+    past_recording: usize,
+}
+
 /// The judgement of a comparison.
 #[derive(Debug, Clone, Serialize)]
 pub struct Verdict {
@@ -210,135 +222,20 @@ impl Verdict {
         } else {
             runs_outside_shares(&periods, &compared, dem_runs)
         };
-        // the yardstick beside the median: how the DEM runs themselves score on it, and how
-        // often each is beyond the others' range
-        let yardstick = yardstick_words(
-            median_ratio,
-            &dem_runs_median_ratio,
-            &dem_runs_outside_share,
-            compared.len(),
-            outside_range.len(),
-        );
         let one_pair = dem_runs == 2;
         let passes = median_ratio.map(|m| m <= 1.0 && (one_pair || outside_range.is_empty()));
-        let what = if groups { "group means" } else { "bed mean" };
-        let means = match (error, spread) {
-            (Some(e), Some(s)) => format!(
-                "; {what} within {} of the DEM's (the DEM runs differ by up to {})",
-                kelvin(e),
-                kelvin(s)
-            ),
-            (Some(e), None) => format!("; {what} within {} of the DEM's", kelvin(e)),
-            _ => String::new(),
-        };
         let (lo, hi) = (
             ratios.iter().copied().fold(f64::INFINITY, f64::min),
             ratios.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         );
-        let range = if ratios.len() > 1 {
-            format!("{}–{}", num(lo), num(hi))
-        } else {
-            ratios.first().map_or(String::new(), |r| num(*r))
+        let setting = Setting {
+            dem_runs,
+            departure,
+            groups,
+            floors,
+            past_recording: periods.len(),
         };
-        // the recorded span, named so that a reader knows why the verdict starts later
-        let left_out = if within_recording.is_empty() {
-            String::new()
-        } else {
-            format!(
-                "; {} left out, where the extrapolation is still the recorded run",
-                instants(&within_recording, within_recording.len())
-            )
-        };
-        // which runs its distance went to and how fair their spread is, where it is not
-        // simply all of them
-        let runs_note = match departure {
-            _ if dem_runs < 2 || median_ratio.is_none() => String::new(),
-            Departure::BeforeTheTwins { left, parted } => {
-                let fair_from = parted + 1;
-                format!(
-                    "; the twins parted from the DEM at t{parted}, after the extrapolation left \
-                     it (t{left}): their spread from t{fair_from} on is narrower than a fair \
-                     floor for it"
-                )
-            }
-            _ => departure.runs_measured_to().map_or(String::new(), |runs| {
-                format!("; its distance measured to {runs}")
-            }),
-        };
-        let text = match (passes, median_ratio) {
-            (Some(true), Some(m)) => format!(
-                "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}\
-                 {runs_note}",
-                instants(&compared, compared.len()),
-                beside_one(m),
-                if outside_range.is_empty() {
-                    "never beyond the farthest two".to_string()
-                } else {
-                    // only with one pair of runs (above): say where, and why it passes
-                    format!(
-                        "farther from the two DEM runs than they are from each other at {}, \
-                         as a further DEM run would be at about half the t_k (one twin: the \
-                         median decides)",
-                        instants(&outside_range, periods.len())
-                    )
-                }
-            ),
-            (Some(false), Some(m)) => {
-                let beyond = if outside_range.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "; farther {} at {}",
-                        if dem_runs == 2 {
-                            "from the two DEM runs than they are from each other"
-                        } else {
-                            "than the two farthest DEM runs"
-                        },
-                        instants(&outside_range, periods.len())
-                    )
-                };
-                // with three runs their range is still narrow: an exchangeable further run
-                // falls outside it at some t_k most of the time, so a narrow miss is read
-                // through the median; a genuine DEM run's median lay within 0.96-1.08
-                // (docs/validation.md), hence 1.1. (With two runs the median decides.)
-                let few = if dem_runs == 3 && !outside_range.is_empty() && m <= 1.1 {
-                    format!(
-                        " (with only {dem_runs} DEM runs, a genuine further DEM run also \
-                         falls outside their range at some t_k: read the median ratio)"
-                    )
-                } else {
-                    String::new()
-                };
-                format!(
-                    "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}\
-                     {runs_note}",
-                    instants(&compared, compared.len()),
-                    if m > 1.0 {
-                        format!("{} > 1", above_one(m))
-                    } else {
-                        num(m)
-                    },
-                )
-            }
-            _ if floors && compared.is_empty() && !within_recording.is_empty() => format!(
-                "not judged: at every compared t_k ({}) the extrapolation is still the recorded \
-                 run, which it follows until its first jump through a pairing; compare t_k past \
-                 the recorded periods{means}",
-                instants(&within_recording, within_recording.len())
-            ),
-            _ if floors => format!(
-                "the {dem_runs} DEM runs are identical at every compared t_k (floor 0): there \
-                 is no spread to judge the extrapolation against{means}"
-            ),
-            _ => format!(
-                "not judged: one DEM run alone is no yardstick, since two runs of a chaotic \
-                 flow part by particle diameters within a period (record with --twins 2 to \
-                 measure the DEM's own spread){means}"
-            ),
-        };
-        Self {
+        let mut verdict = Self {
             passes,
             median_ratio,
             ratio_min: (!ratios.is_empty()).then_some(lo),
@@ -352,7 +249,148 @@ impl Verdict {
             dem_runs_outside_share,
             means_in_seat,
             dem_runs_means,
-            text,
+            text: String::new(),
+        };
+        verdict.text = verdict.words(&setting);
+        verdict
+    }
+
+    /// The verdict in words, from its figures and its `setting`.
+    fn words(&self, setting: &Setting) -> String {
+        let dem_runs = setting.dem_runs;
+        // the yardstick beside the median: how the DEM runs themselves score on it, and how
+        // often each is beyond the others' range
+        let yardstick = yardstick_words(
+            self.median_ratio,
+            &self.dem_runs_median_ratio,
+            &self.dem_runs_outside_share,
+            self.compared.len(),
+            self.outside_range.len(),
+        );
+        let what = if setting.groups {
+            "group means"
+        } else {
+            "bed mean"
+        };
+        let means = match (self.means_error_max, self.means_spread_max) {
+            (Some(e), Some(s)) => format!(
+                "; {what} within {} of the DEM's (the DEM runs differ by up to {})",
+                kelvin(e),
+                kelvin(s)
+            ),
+            (Some(e), None) => format!("; {what} within {} of the DEM's", kelvin(e)),
+            _ => String::new(),
+        };
+        let range = match (self.ratio_min, self.ratio_max) {
+            (Some(lo), Some(hi)) if self.compared.len() > 1 => format!("{}–{}", num(lo), num(hi)),
+            (Some(only), _) => num(only),
+            _ => String::new(),
+        };
+        // the recorded span, named so that a reader knows why the verdict starts later
+        let left_out = if self.within_recording.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} left out, where the extrapolation is still the recorded run",
+                instants(&self.within_recording, self.within_recording.len())
+            )
+        };
+        // which runs its distance went to and how fair their spread is, where it is not
+        // simply all of them
+        let runs_note = match setting.departure {
+            _ if setting.dem_runs < 2 || self.median_ratio.is_none() => String::new(),
+            Departure::BeforeTheTwins { left, parted } => {
+                let fair_from = parted + 1;
+                format!(
+                    "; the twins parted from the DEM at t{parted}, after the extrapolation left \
+                     it (t{left}): their spread from t{fair_from} on is narrower than a fair \
+                     floor for it"
+                )
+            }
+            _ => setting
+                .departure
+                .runs_measured_to()
+                .map_or(String::new(), |runs| {
+                    format!("; its distance measured to {runs}")
+                }),
+        };
+        match (self.passes, self.median_ratio) {
+            (Some(true), Some(m)) => format!(
+                "passes as one more DEM run: its distance to the DEM runs is {range} times \
+                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}\
+                 {runs_note}",
+                instants(&self.compared, self.compared.len()),
+                beside_one(m),
+                if self.outside_range.is_empty() {
+                    "never beyond the farthest two".to_string()
+                } else {
+                    // only with one pair of runs (above): say where, and why it passes
+                    format!(
+                        "farther from the two DEM runs than they are from each other at {}, \
+                         as a further DEM run would be at about half the t_k (one twin: the \
+                         median decides)",
+                        instants(&self.outside_range, setting.past_recording)
+                    )
+                }
+            ),
+            (Some(false), Some(m)) => {
+                let beyond = if self.outside_range.is_empty() {
+                    String::new()
+                } else {
+                    format!(
+                        "; farther {} at {}",
+                        if setting.dem_runs == 2 {
+                            "from the two DEM runs than they are from each other"
+                        } else {
+                            "than the two farthest DEM runs"
+                        },
+                        instants(&self.outside_range, setting.past_recording)
+                    )
+                };
+                // with three runs their range is still narrow: an exchangeable further run
+                // falls outside it at some t_k most of the time, so a narrow miss is read
+                // through the median; a genuine DEM run's median lay within 0.96-1.08
+                // (docs/validation.md), hence 1.1. (With two runs the median decides.)
+                let few = if setting.dem_runs == 3 && !self.outside_range.is_empty() && m <= 1.1 {
+                    format!(
+                        " (with only {dem_runs} DEM runs, a genuine further DEM run also \
+                         falls outside their range at some t_k: read the median ratio)"
+                    )
+                } else {
+                    String::new()
+                };
+                format!(
+                    "does not pass as one more DEM run: {range} times the DEM runs' distance to \
+                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}\
+                     {runs_note}",
+                    instants(&self.compared, self.compared.len()),
+                    if m > 1.0 {
+                        format!("{} > 1", above_one(m))
+                    } else {
+                        num(m)
+                    },
+                )
+            }
+            _ if setting.floors
+                && self.compared.is_empty()
+                && !self.within_recording.is_empty() =>
+            {
+                format!(
+                "not judged: at every compared t_k ({}) the extrapolation is still the recorded \
+                 run, which it follows until its first jump through a pairing; compare t_k past \
+                 the recorded periods{means}",
+                instants(&self.within_recording, self.within_recording.len())
+            )
+            }
+            _ if setting.floors => format!(
+                "the {dem_runs} DEM runs are identical at every compared t_k (floor 0): there \
+                 is no spread to judge the extrapolation against{means}"
+            ),
+            _ => format!(
+                "not judged: one DEM run alone is no yardstick, since two runs of a chaotic \
+                 flow part by particle diameters within a period (record with --twins 2 to \
+                 measure the DEM's own spread){means}"
+            ),
         }
     }
 
