@@ -9,7 +9,7 @@
 //! the same seat, each with its standard error over the draws, and the share of compared
 //! `t_k` outside the DEM runs' range for both.
 
-use super::verdict::{kelvin, num, SeatMeans, MEANS_TOLERANCE};
+use super::verdict::{kelvin, num, SeatMeans};
 use super::{CompareError, Comparison, ContrastKind};
 use serde::Serialize;
 use tdex_format::RecordingInfo;
@@ -120,7 +120,7 @@ impl Draw {
         let error_to_spread = |seats: &[SeatMeans]| {
             seats
                 .iter()
-                .map(|s| (s.spread_max > MEANS_TOLERANCE).then_some(s.error_max / s.spread_max))
+                .map(SeatMeans::error_to_spread)
                 .collect::<Option<Vec<f64>>>()
                 .and_then(|r| mean(&r))
         };
@@ -146,7 +146,11 @@ impl Draw {
     /// Whether the group (bed) means are within the DEM runs' spread at every compared
     /// `t_k`: the largest error no larger than the largest difference between two runs.
     pub fn means_within_spread(&self) -> bool {
-        self.means_error_max <= self.means_spread_max + MEANS_TOLERANCE
+        let means = SeatMeans {
+            error_max: self.means_error_max,
+            spread_max: self.means_spread_max,
+        };
+        !means.outside()
     }
 }
 
@@ -262,9 +266,15 @@ impl Draws {
         Ok(pooled)
     }
 
+    /// Whether the means judged are the hot and cold groups' (else the bed's): the draws
+    /// are of one case, so the first says it for all.
+    pub fn of_groups(&self) -> bool {
+        self.each.first().is_some_and(|d| d.groups)
+    }
+
     /// The pooled judgement in words, from its figures.
     fn words(&self) -> String {
-        let groups = self.each.first().is_some_and(|d| d.groups);
+        let groups = self.of_groups();
         let n = self.draws;
         let difference_se = self
             .median_ratio

@@ -9,7 +9,7 @@ use serde::Serialize;
 /// Room for float noise when a group (bed) mean error is set against the DEM runs'
 /// spread, K: a conserved bed mean differs between runs only by rounding, and so does its
 /// error, which must then not fail on the last bits.
-pub(crate) const MEANS_TOLERANCE: f64 = 1e-9;
+const MEANS_TOLERANCE: f64 = 1e-9;
 
 /// A field judged on the group (bed) means against some of the DEM runs, K.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -25,6 +25,12 @@ impl SeatMeans {
     /// Whether the field strays beyond those runs' spread.
     pub fn outside(&self) -> bool {
         self.error_max > self.spread_max + MEANS_TOLERANCE
+    }
+
+    /// How far: the largest error over the largest spread; `None` where the spread is only
+    /// rounding, as of a conserved bed mean.
+    pub fn error_to_spread(&self) -> Option<f64> {
+        (self.spread_max > MEANS_TOLERANCE).then_some(self.error_max / self.spread_max)
     }
 }
 

@@ -511,11 +511,7 @@ fn pooled_table(s: &HorizonStudy) -> String {
          spread at some t_k, which fails the pooled verdict; then in a DEM run's seat, against \
          the other runs, beside a DEM run judged the same way: the share of seats where they \
          stray beyond those runs' spread, and their largest error over that spread):\n",
-        if s.pooled
-            .first()
-            .and_then(|r| r.draws.each.first())
-            .is_some_and(|d| d.groups)
-        {
+        if s.pooled.first().is_some_and(|r| r.draws.of_groups()) {
             "group"
         } else {
             "bed"
