@@ -15,6 +15,7 @@ use super::ContactSampler;
 use crate::case::Case;
 use crate::Simulation;
 use std::borrow::Cow;
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 use tdex_format::{RecordingSummary, RecordingWriter, Snapshot};
@@ -355,11 +356,12 @@ fn check_twin_differs(
 
 /// The whole run from wherever it stands: settle, spin-up, the recorded periods, the
 /// reference periods after them, the DEM twins, with checkpoints when `saver` is given (a run with one
-/// recording). Returns each recording's summary, in the order of the jobs.
+/// recording). Returns each recording's summary, in the order of the jobs. A resumed run
+/// takes the fresh run's path: each stage starts where the checkpoint left it.
 fn drive(
     dem: &DemRun,
     start: Start,
-    mut saver: Option<Saver>,
+    saver: Option<Saver>,
     progress: &mut dyn FnMut(Phase, u64, u64),
 ) -> Result<Vec<RecordingSummary>, RecordError> {
     let fresh_samplers = dem
@@ -372,177 +374,289 @@ fn drive(
         return Ok(Vec::new());
     };
     let mut own_sim;
-    let (sim, mut stage, mut elapsed, output, mut at_t1) = match start {
+    let (sim, mut run, output) = match start {
         Start::Case(case) => {
             own_sim = Simulation::new(case)?;
-            let stage = Stage::Settle { done: 0 };
-            (&mut own_sim, stage, Elapsed::default(), None, None)
+            let run = RunState::new(Stage::Settle { done: 0 }, Elapsed::default(), None, saver);
+            (&mut own_sim, run, None)
         }
         Start::AtT0 { sim, seconds_to_t0 } => {
             let elapsed = Elapsed {
                 to_t0: seconds_to_t0,
                 ..Elapsed::default()
             };
-            (
-                sim,
-                Stage::Period { period: 0, done: 0 },
-                elapsed,
-                None,
-                None,
-            )
+            let stage = Stage::Period { period: 0, done: 0 };
+            (sim, RunState::new(stage, elapsed, None, saver), None)
         }
         Start::Restored(r) => {
             let r = *r;
             own_sim = r.sim;
-            (&mut own_sim, r.stage, r.elapsed, r.output, r.t1)
+            let run = RunState::new(r.stage, r.elapsed, r.t1, saver);
+            (&mut own_sim, run, r.output)
         }
     };
+    run.settle_and_spin_up(sim, progress)?;
+    let mut outputs = match output {
+        None => Outputs::open(dem, sim, fresh_samplers, &run)?,
+        Some(out) => Outputs::reopen(dem, opts, sim, out, &run)?,
+    };
+    let mut parting = Parting::of(opts, &outputs.snapshots);
+    run.recorded_periods(sim, dem, opts, &mut outputs, &mut parting, progress)?;
+    let main_stage_seconds = run.past_t1(sim, opts, &mut outputs, &parting, progress)?;
+    run.finish(dem, sim, outputs, main_stage_seconds)
+}
 
-    // to t0
-    if matches!(stage, Stage::Settle { .. } | Stage::SpinUp { .. }) {
-        let (began, base) = (Instant::now(), elapsed.to_t0);
-        let to_t0 = |elapsed: &Elapsed| Elapsed {
-            to_t0: base + began.elapsed().as_secs_f64(),
-            ..elapsed.clone()
+/// Where a run stands between its stages: the stage it has reached, its wall times so far,
+/// the engine at the twins' start (kept from `t_s` while DEM twins are to come) and the
+/// writer of its checkpoints.
+struct RunState<'s> {
+    stage: Stage,
+    elapsed: Elapsed,
+    at_t1: Option<Simulation>,
+    saver: Option<Saver<'s>>,
+}
+
+/// What a run has written so far: each recording's sink and sampler, and what its
+/// checkpoints carry.
+struct Outputs {
+    sinks: Vec<RowSink>,
+    samplers: Vec<ContactSampler>,
+    /// `t0` and every snapshot since, kept only while the run is checkpointed (a snapshot is
+    /// 68 B a particle); `t0` alone otherwise.
+    snapshots: Vec<Snapshot>,
+    run_at_t0: RunAtT0,
+    /// Each recording's own recorder seconds; a checkpointed run has one recording, whose
+    /// seconds [`Elapsed::recorder`] carries.
+    recorder_seconds: Vec<f64>,
+}
+
+/// The run's snapshots the DEM twins need. Twins part from the run at `t_s` (`s` =
+/// `twins_from`, a recorded snapshot): until there a twin is the run, so its snapshots
+/// `t2 … t_s` are the run's (kept here), and its first own one, `t_(s+1)`, is checked
+/// against the run's.
+struct Parting {
+    at: u32,
+    with_twins: bool,
+    before: Vec<Snapshot>,
+    dem_next: Option<Snapshot>,
+}
+
+impl Parting {
+    /// What the snapshots a run has written (`t0` on, the run's own first) tell.
+    fn of(opts: &RecordOptions, snapshots: &[Snapshot]) -> Parting {
+        let own = opts.last_snapshot() as usize + 1;
+        let mut parting = Parting {
+            at: opts.twins_from,
+            with_twins: opts.twins > 0,
+            before: Vec::new(),
+            dem_next: None,
         };
-        stage = advance_to_t0(sim, stage, progress, &mut |sim, stage| match &mut saver {
-            Some(s) if s.due() => s.save(sim, stage, to_t0(&elapsed), None),
-            _ => Ok(()),
-        })?;
-        elapsed = to_t0(&elapsed);
+        for snapshot in snapshots.iter().take(own) {
+            parting.note(snapshot);
+        }
+        parting
     }
 
-    // the outputs: opened at t0, or rebuilt to where the checkpoint left them
-    let journal = saver.as_ref().map(|s| s.journal.clone());
-    let (mut sinks, mut samplers, mut snapshots, run_at_t0) = match output {
-        None => {
-            let run_at_t0 = RunAtT0::of(sim);
-            let t0 = sim.snapshot(0);
-            let mut sinks = Vec::with_capacity(dem.jobs.len());
-            for job in dem.jobs {
-                let info = recording_info(
-                    &sim.case,
-                    dem.case_path,
-                    dem.case_toml,
-                    &job.options,
-                    run_at_t0.clone(),
-                );
-                let mut writer = RecordingWriter::create(job.dest, info)?;
-                writer.write_snapshot(&t0)?;
-                let journal = match &journal {
-                    Some(path) => Some(RowJournal::create(path)?),
-                    None => None,
-                };
-                sinks.push(RowSink { writer, journal });
-            }
-            (sinks, fresh_samplers, vec![t0], run_at_t0)
+    /// The run's snapshot `t_k`, just written: kept if the twins need it.
+    fn note(&mut self, snapshot: &Snapshot) {
+        if !self.with_twins {
+            return;
         }
-        Some(out) => {
+        if (2..=self.at).contains(&snapshot.index) {
+            self.before.push(snapshot.clone());
+        }
+        if snapshot.index == self.at + 1 {
+            self.dem_next = Some(snapshot.clone());
+        }
+    }
+}
+
+impl Outputs {
+    /// The outputs of a run at `t0`: each recording created with its first snapshot.
+    fn open(
+        dem: &DemRun,
+        sim: &Simulation,
+        samplers: Vec<ContactSampler>,
+        run: &RunState,
+    ) -> Result<Outputs, RecordError> {
+        let journal = run.saver.as_ref().map(|s| &s.journal);
+        let run_at_t0 = RunAtT0::of(sim);
+        let t0 = sim.snapshot(0);
+        let mut sinks = Vec::with_capacity(dem.jobs.len());
+        for job in dem.jobs {
             let info = recording_info(
                 &sim.case,
                 dem.case_path,
                 dem.case_toml,
-                opts,
-                out.run.clone(),
+                &job.options,
+                run_at_t0.clone(),
             );
-            let mut writer = RecordingWriter::create(dem.jobs[0].dest, info)?;
-            writer.write_snapshot(&out.snapshots[0])?;
-            let path = journal.as_ref().expect("a resumed run keeps checkpointing");
-            // the rows and the recorded snapshots in the order the run wrote them (a snapshot
-            // closes the chunk before it): t_k after the rows of period k - 1, before the first
-            // row of a later period
-            let mut next = 1;
-            let journal = RowJournal::resume(path, out.journal, &mut |mut rows| {
-                while let Some(first) = rows.first() {
-                    let period = first.start_step / opts.period_steps;
-                    while next as u64 <= period {
-                        let snapshot = out.snapshots.get(next).ok_or_else(|| {
-                            CheckpointError::Inconsistent {
-                                path: saver.as_ref().map_or_else(Default::default, |s| s.path()),
+            let mut writer = RecordingWriter::create(job.dest, info)?;
+            writer.write_snapshot(&t0)?;
+            let journal = match journal {
+                Some(path) => Some(RowJournal::create(path)?),
+                None => None,
+            };
+            sinks.push(RowSink { writer, journal });
+        }
+        Ok(Outputs {
+            recorder_seconds: vec![run.elapsed.recorder; sinks.len()],
+            sinks,
+            samplers,
+            snapshots: vec![t0],
+            run_at_t0,
+        })
+    }
+
+    /// The output of a checkpointed run rebuilt to where the checkpoint left it: the rows
+    /// of its journal and its snapshots written again in the order the run wrote them.
+    fn reopen(
+        dem: &DemRun,
+        opts: &RecordOptions,
+        sim: &Simulation,
+        out: OutputState<'static>,
+        run: &RunState,
+    ) -> Result<Outputs, RecordError> {
+        let saver = run
+            .saver
+            .as_ref()
+            .expect("a resumed run keeps checkpointing");
+        let info = recording_info(
+            &sim.case,
+            dem.case_path,
+            dem.case_toml,
+            opts,
+            out.run.clone(),
+        );
+        let mut writer = RecordingWriter::create(dem.jobs[0].dest, info)?;
+        writer.write_snapshot(&out.snapshots[0])?;
+        // a snapshot closes the chunk before it: t_k after the rows of period k - 1, before
+        // the first row of a later period
+        let mut next = 1;
+        let journal = RowJournal::resume(&saver.journal, out.journal, &mut |mut rows| {
+            while let Some(first) = rows.first() {
+                let period = first.start_step / opts.period_steps;
+                while next as u64 <= period {
+                    let snapshot =
+                        out.snapshots
+                            .get(next)
+                            .ok_or_else(|| CheckpointError::Inconsistent {
+                                path: saver.path(),
                                 detail: format!(
                                     "its row journal holds rows of recorded period {period}, its \
                                      snapshots end at t{}",
                                     next - 1
                                 ),
-                            }
-                        })?;
-                        writer.write_snapshot(snapshot)?;
-                        next += 1;
-                    }
-                    let same = rows
-                        .iter()
-                        .position(|r| r.start_step / opts.period_steps != period)
-                        .unwrap_or(rows.len());
-                    writer.push_rows(rows[..same].iter().copied())?;
-                    rows = &rows[same..];
+                            })?;
+                    writer.write_snapshot(snapshot)?;
+                    next += 1;
                 }
-                Ok::<_, RecordError>(())
-            })?;
-            // the run's own snapshots left, then each twin's, in the order they were written
-            let own = opts.last_snapshot() as usize + 1;
-            for (k, snapshot) in out.snapshots.iter().enumerate().skip(next) {
-                match k.checked_sub(own) {
-                    None => writer.write_snapshot(snapshot)?,
-                    Some(past) => writer.write_twin_snapshot(
-                        1 + (past / opts.reference_periods as usize) as u32,
-                        snapshot,
-                    )?,
-                }
+                let same = rows
+                    .iter()
+                    .position(|r| r.start_step / opts.period_steps != period)
+                    .unwrap_or(rows.len());
+                writer.push_rows(rows[..same].iter().copied())?;
+                rows = &rows[same..];
             }
-            let sink = RowSink {
+            Ok::<_, RecordError>(())
+        })?;
+        // the run's own snapshots left, then each twin's, in the order they were written
+        let own = opts.last_snapshot() as usize + 1;
+        for (k, snapshot) in out.snapshots.iter().enumerate().skip(next) {
+            match k.checked_sub(own) {
+                None => writer.write_snapshot(snapshot)?,
+                Some(past) => writer.write_twin_snapshot(
+                    1 + (past / opts.reference_periods as usize) as u32,
+                    snapshot,
+                )?,
+            }
+        }
+        Ok(Outputs {
+            sinks: vec![RowSink {
                 writer,
                 journal: Some(journal),
-            };
-            (
-                vec![sink],
-                vec![out.sampler.into_owned()],
-                out.snapshots.into_owned(),
-                out.run,
-            )
+            }],
+            samplers: vec![out.sampler.into_owned()],
+            snapshots: out.snapshots.into_owned(),
+            run_at_t0: out.run,
+            recorder_seconds: vec![run.elapsed.recorder],
+        })
+    }
+}
+
+impl<'s> RunState<'s> {
+    fn new(
+        stage: Stage,
+        elapsed: Elapsed,
+        at_t1: Option<Simulation>,
+        saver: Option<Saver<'s>>,
+    ) -> RunState<'s> {
+        RunState {
+            stage,
+            elapsed,
+            at_t1,
+            saver,
         }
-    };
-    // each recording's own recorder seconds; a checkpointed run has one recording, whose
-    // seconds `elapsed.recorder` carries
-    let mut recorder_seconds = vec![elapsed.recorder; sinks.len()];
+    }
 
-    // DEM twins part from the run at t_s (s = `twins_from`): until there a twin is the run,
-    // so its snapshots t2 … t_s are the run's (kept here), and its first own one, t_(s+1),
-    // is checked against the run's
-    let parting = opts.twins_from;
-    let own = opts.last_snapshot() as usize + 1;
-    let mut before_parting: Vec<Snapshot> = snapshots
-        .iter()
-        .take(own)
-        .filter(|s| opts.twins > 0 && (2..=parting).contains(&s.index))
-        .cloned()
-        .collect();
-    let mut dem_t2 = snapshots
-        .get(parting as usize + 1)
-        .filter(|_| opts.twins > 0)
-        .cloned();
+    /// Settles and spins up to `t0`, if the run stands before it.
+    fn settle_and_spin_up(
+        &mut self,
+        sim: &mut Simulation,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+    ) -> Result<(), RecordError> {
+        if !matches!(self.stage, Stage::Settle { .. } | Stage::SpinUp { .. }) {
+            return Ok(());
+        }
+        let (began, base) = (Instant::now(), self.elapsed.to_t0);
+        let to_t0 = |elapsed: &Elapsed| Elapsed {
+            to_t0: base + began.elapsed().as_secs_f64(),
+            ..elapsed.clone()
+        };
+        let (saver, elapsed) = (&mut self.saver, &self.elapsed);
+        let stage = advance_to_t0(sim, self.stage, progress, &mut |sim, stage| match saver {
+            Some(s) if s.due() => s.save(sim, stage, to_t0(elapsed), None),
+            _ => Ok(()),
+        })?;
+        self.stage = stage;
+        self.elapsed = to_t0(&self.elapsed);
+        Ok(())
+    }
 
-    // the recorded periods, one after the other: the samplers are cut at each boundary
-    if let Stage::Period {
-        period: first,
-        done,
-    } = stage
-    {
+    /// The recorded periods, one after the other, from where the run stands among them:
+    /// the samplers are cut at each boundary, each period's snapshot closes its rows.
+    fn recorded_periods(
+        &mut self,
+        sim: &mut Simulation,
+        dem: &DemRun,
+        opts: &RecordOptions,
+        outputs: &mut Outputs,
+        parting: &mut Parting,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+    ) -> Result<(), RecordError> {
+        let Stage::Period {
+            period: first,
+            done,
+        } = self.stage
+        else {
+            return Ok(());
+        };
         let recorded = opts.recorded_periods;
         let every: Vec<u64> = dem
             .jobs
             .iter()
             .map(|j| j.options.sample_every as u64)
             .collect();
-        elapsed.each_period.resize(recorded as usize, 0.0);
+        self.elapsed.each_period.resize(recorded as usize, 0.0);
         for index in first..recorded {
             let began = Instant::now();
             let mut hook = PeriodSaver {
-                saver: saver.as_mut(),
-                run_at_t0: &run_at_t0,
-                snapshots: &snapshots,
-                at_t1: at_t1.as_ref(),
+                saver: self.saver.as_mut(),
+                run_at_t0: &outputs.run_at_t0,
+                snapshots: &outputs.snapshots,
+                at_t1: self.at_t1.as_ref(),
                 period: index,
-                elapsed: elapsed.clone(),
+                elapsed: self.elapsed.clone(),
                 began,
             };
             let checkpoints: Option<&mut dyn PeriodCheckpoint> = match hook.saver {
@@ -555,175 +669,134 @@ fn drive(
                 steps: opts.period_steps,
             };
             let start = if index == first { done } else { 0 };
-            let busy;
-            (samplers, busy) = record_period(
+            let (samplers, busy) = record_period(
                 sim,
-                samplers,
-                &mut sinks,
+                std::mem::take(&mut outputs.samplers),
+                &mut outputs.sinks,
                 &every,
                 period,
                 start,
                 checkpoints,
                 progress,
             )?;
+            outputs.samplers = samplers;
             let snapshot = sim.snapshot(index + 1);
-            for ((sink, seconds), busy) in sinks.iter_mut().zip(&mut recorder_seconds).zip(busy) {
+            let seconds = outputs.recorder_seconds.iter_mut();
+            for ((sink, seconds), busy) in outputs.sinks.iter_mut().zip(seconds).zip(busy) {
                 let t = Instant::now();
                 sink.writer.write_snapshot(&snapshot)?;
                 *seconds += busy + t.elapsed().as_secs_f64();
             }
-            if index + 1 == parting && opts.twins > 0 {
-                at_t1 = Some(sim.clone());
+            if index + 1 == parting.at && parting.with_twins {
+                self.at_t1 = Some(sim.clone());
             }
-            if (2..=parting).contains(&snapshot.index) && opts.twins > 0 {
-                before_parting.push(snapshot.clone());
+            parting.note(&snapshot);
+            if self.saver.is_some() {
+                outputs.snapshots.push(snapshot);
             }
-            if snapshot.index == parting + 1 && opts.twins > 0 {
-                dem_t2 = Some(snapshot.clone());
-            }
-            // kept only for the checkpoints: a snapshot is 68 B a particle
-            if saver.is_some() {
-                snapshots.push(snapshot);
-            }
-            elapsed.recorder = recorder_seconds[0];
+            self.elapsed.recorder = outputs.recorder_seconds[0];
             let seconds = began.elapsed().as_secs_f64();
-            elapsed.period += seconds;
-            elapsed.each_period[index as usize] += seconds;
+            self.elapsed.period += seconds;
+            self.elapsed.each_period[index as usize] += seconds;
         }
         // the reference periods go on after tP (those up to tP are recorded ones)
-        stage = Stage::Reference {
+        self.stage = Stage::Reference {
             period: recorded - 1,
             done: 0,
         };
+        Ok(())
     }
 
-    // the reference periods, then the DEM twins, each from t1 over the same periods (the
-    // run's own t2 is kept to check that the twins differ from it)
-    let mut main_stage_seconds = None;
-    if matches!(stage, Stage::Reference { .. } | Stage::Twin { .. }) {
-        let mark = match sinks.first_mut().and_then(|s| s.journal.as_mut()) {
+    /// The reference periods, then the DEM twins, each from `t_s` over the same periods,
+    /// from where the run stands among them. Returns the run's own stage times when the
+    /// engine was replaced by a twin's.
+    fn past_t1(
+        &mut self,
+        sim: &mut Simulation,
+        opts: &RecordOptions,
+        outputs: &mut Outputs,
+        parting: &Parting,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+    ) -> Result<Option<BTreeMap<String, f64>>, RecordError> {
+        if !matches!(self.stage, Stage::Reference { .. } | Stage::Twin { .. }) {
+            return Ok(None);
+        }
+        let mut main_stage_seconds = None;
+        let mark = match outputs.sinks.first_mut().and_then(|s| s.journal.as_mut()) {
             Some(j) => Some(j.sync()?),
             None => None,
         };
+        let mut dem_next = parting.dem_next.clone();
         let mut past_t1 = PastT1 {
             opts,
-            saver: saver.as_mut(),
+            saver: self.saver.as_mut(),
             mark,
-            run_at_t0: &run_at_t0,
-            sampler: &samplers[0],
-            at_t1: at_t1.as_ref(),
-            elapsed,
+            run_at_t0: &outputs.run_at_t0,
+            sampler: &outputs.samplers[0],
+            at_t1: self.at_t1.as_ref(),
+            parting,
+            elapsed: self.elapsed.clone(),
             began: Instant::now(),
         };
-        if let Stage::Reference {
-            period: first,
-            done,
-        } = stage
-        {
-            past_t1.periods(
-                sim,
-                Continuation::Reference,
-                (first, done),
-                &mut snapshots,
-                progress,
-                &mut |_, snapshot| {
-                    for sink in sinks.iter_mut() {
-                        sink.writer.write_snapshot(snapshot)?;
-                    }
-                    if snapshot.index == parting + 1 && opts.twins > 0 {
-                        dem_t2 = Some(snapshot.clone());
-                    }
-                    Ok(())
-                },
-            )?;
-            past_t1.stage_done(Continuation::Reference);
-            if let Some(t1) = &at_t1 {
+        let mut written = Written {
+            sinks: &mut outputs.sinks,
+            snapshots: &mut outputs.snapshots,
+        };
+        if let Stage::Reference { period, done } = self.stage {
+            past_t1.reference(sim, (period, done), &mut written, &mut dem_next, progress)?;
+            if let Some(t1) = past_t1.at_t1 {
                 main_stage_seconds = Some(stage_seconds(sim));
                 *sim = twin_of(t1, 1);
-                stage = Stage::Twin {
+                self.stage = Stage::Twin {
                     twin: 1,
                     period: 0,
                     done: 0,
                 };
             }
         }
-        if let Stage::Twin {
-            twin: first,
-            period: first_period,
-            done,
-        } = stage
-        {
-            let t1 = at_t1.as_ref().ok_or_else(|| {
-                RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
-            })?;
-            for twin in first..=opts.twins {
-                if twin != first {
-                    *sim = twin_of(t1, twin);
-                }
-                let mut from = if twin == first {
-                    (first_period, done)
-                } else {
-                    (0, 0)
-                };
-                // before it parts the twin is the run: the run's snapshots t2 … t_s, stored
-                // as the twin's so that every run holds t2 … t(K+1)
-                if from.0 + 1 < parting {
-                    for snapshot in &before_parting[from.0 as usize..] {
-                        for sink in sinks.iter_mut() {
-                            sink.writer.write_twin_snapshot(twin, snapshot)?;
-                        }
-                        if past_t1.saver.is_some() {
-                            snapshots.push(snapshot.clone());
-                        }
-                    }
-                    from = (parting - 1, 0);
-                }
-                past_t1.periods(
-                    sim,
-                    Continuation::Twin(twin),
-                    from,
-                    &mut snapshots,
-                    progress,
-                    &mut |period, snapshot| {
-                        if period + 1 == parting {
-                            check_twin_differs(twin, snapshot, dem_t2.as_ref())?;
-                        }
-                        for sink in sinks.iter_mut() {
-                            sink.writer.write_twin_snapshot(twin, snapshot)?;
-                        }
-                        Ok(())
-                    },
-                )?;
-            }
-            past_t1.stage_done(Continuation::Twin(first));
+        if let Stage::Twin { twin, period, done } = self.stage {
+            let from = (twin, period, done);
+            past_t1.twins(sim, from, &mut written, dem_next.as_ref(), progress)?;
         }
-        elapsed = past_t1.elapsed.clone();
+        self.elapsed = past_t1.elapsed.clone();
+        Ok(main_stage_seconds)
     }
 
-    // the run's own stages; a run resumed among its twins has only the last twin's, which
-    // carry the run's up to t1
-    let stage_seconds = main_stage_seconds.unwrap_or_else(|| stage_seconds(sim));
-    let summaries = sinks
-        .into_iter()
-        .zip(samplers)
-        .zip(recorder_seconds)
-        .map(|((sink, sampler), recorder)| {
-            let costs = dem.write_costs.then(|| {
-                Elapsed {
-                    recorder,
-                    ..elapsed.clone()
-                }
-                .costs(stage_seconds.clone())
-            });
-            let RowSink { writer, journal } = sink;
-            drop(journal);
-            Ok(writer.finish(sampler.duration_histogram().to_vec(), costs.as_ref())?)
-        })
-        .collect::<Result<Vec<_>, RecordError>>()?;
-    if let Some(s) = saver {
-        s.remove();
+    /// Closes every recording with its summary and (when asked) its costs; removes the
+    /// checkpoint, no longer needed. The run's own stage times are `main_stage_seconds`
+    /// when a twin replaced its engine; a run resumed among its twins has only the last
+    /// twin's, which carry the run's up to `t_s`.
+    fn finish(
+        self,
+        dem: &DemRun,
+        sim: &Simulation,
+        outputs: Outputs,
+        main_stage_seconds: Option<BTreeMap<String, f64>>,
+    ) -> Result<Vec<RecordingSummary>, RecordError> {
+        let stage_seconds = main_stage_seconds.unwrap_or_else(|| stage_seconds(sim));
+        let summaries = outputs
+            .sinks
+            .into_iter()
+            .zip(outputs.samplers)
+            .zip(outputs.recorder_seconds)
+            .map(|((sink, sampler), recorder)| {
+                let costs = dem.write_costs.then(|| {
+                    Elapsed {
+                        recorder,
+                        ..self.elapsed.clone()
+                    }
+                    .costs(stage_seconds.clone())
+                });
+                let RowSink { writer, journal } = sink;
+                drop(journal);
+                Ok(writer.finish(sampler.duration_histogram().to_vec(), costs.as_ref())?)
+            })
+            .collect::<Result<Vec<_>, RecordError>>()?;
+        if let Some(s) = self.saver {
+            s.remove();
+        }
+        Ok(summaries)
     }
-    Ok(summaries)
 }
 
 /// A DEM run continued past `t1` over the reference periods: the run's own, or a twin's.
@@ -759,12 +832,110 @@ struct PastT1<'a, 's> {
     run_at_t0: &'a RunAtT0,
     sampler: &'a ContactSampler,
     at_t1: Option<&'a Simulation>,
+    parting: &'a Parting,
     /// Elapsed times when the stage (re)started.
     elapsed: Elapsed,
     began: Instant,
 }
 
+/// Where the runs past `t1` write: every recording's sink, and the snapshots a checkpoint
+/// carries.
+struct Written<'o> {
+    sinks: &'o mut [RowSink],
+    snapshots: &'o mut Vec<Snapshot>,
+}
+
 impl PastT1<'_, '_> {
+    /// The run's own reference periods from `from` (period, steps done) on; its snapshot
+    /// `t_(s+1)` goes to `dem_next`, for the twins to be checked against.
+    fn reference(
+        &mut self,
+        sim: &mut Simulation,
+        from: (u32, u64),
+        written: &mut Written,
+        dem_next: &mut Option<Snapshot>,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+    ) -> Result<(), RecordError> {
+        let parting = self.parting;
+        let sinks = &mut *written.sinks;
+        self.periods(
+            sim,
+            Continuation::Reference,
+            from,
+            written.snapshots,
+            progress,
+            &mut |_, snapshot| {
+                for sink in sinks.iter_mut() {
+                    sink.writer.write_snapshot(snapshot)?;
+                }
+                if snapshot.index == parting.at + 1 && parting.with_twins {
+                    *dem_next = Some(snapshot.clone());
+                }
+                Ok(())
+            },
+        )?;
+        self.stage_done(Continuation::Reference);
+        Ok(())
+    }
+
+    /// The DEM twins from `from` (twin, period, steps done) on, each from the engine at
+    /// `t_s`; a twin's first own snapshot must differ from the run's, `dem_next`.
+    fn twins(
+        &mut self,
+        sim: &mut Simulation,
+        (first, first_period, done): (u32, u32, u64),
+        written: &mut Written,
+        dem_next: Option<&Snapshot>,
+        progress: &mut dyn FnMut(Phase, u64, u64),
+    ) -> Result<(), RecordError> {
+        let t1 = self.at_t1.ok_or_else(|| {
+            RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
+        })?;
+        let parting = self.parting;
+        for twin in first..=self.opts.twins {
+            if twin != first {
+                *sim = twin_of(t1, twin);
+            }
+            let mut from = if twin == first {
+                (first_period, done)
+            } else {
+                (0, 0)
+            };
+            // before it parts the twin is the run: the run's snapshots t2 … t_s, stored
+            // as the twin's so that every run holds t2 … t(K+1)
+            if from.0 + 1 < parting.at {
+                for snapshot in &parting.before[from.0 as usize..] {
+                    for sink in written.sinks.iter_mut() {
+                        sink.writer.write_twin_snapshot(twin, snapshot)?;
+                    }
+                    if self.saver.is_some() {
+                        written.snapshots.push(snapshot.clone());
+                    }
+                }
+                from = (parting.at - 1, 0);
+            }
+            let sinks = &mut *written.sinks;
+            self.periods(
+                sim,
+                Continuation::Twin(twin),
+                from,
+                written.snapshots,
+                progress,
+                &mut |period, snapshot| {
+                    if period + 1 == parting.at {
+                        check_twin_differs(twin, snapshot, dem_next)?;
+                    }
+                    for sink in sinks.iter_mut() {
+                        sink.writer.write_twin_snapshot(twin, snapshot)?;
+                    }
+                    Ok(())
+                },
+            )?;
+        }
+        self.stage_done(Continuation::Twin(first));
+        Ok(())
+    }
+
     /// The elapsed times with the stage of `which` counted to now.
     fn elapsed_now(&self, which: Continuation) -> Elapsed {
         let now = self.began.elapsed().as_secs_f64();
