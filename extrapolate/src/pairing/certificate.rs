@@ -33,7 +33,7 @@ use super::sparse_lap::Lap;
 /// (the most negative reduced costs). Every violating row still gains an edge, so
 /// repair rounds still make progress, while a row on an expensive edge cannot flood
 /// the graph. (The searches on the auction's potentials return more: see
-/// `AUCTION_PAIRS_PER_ROW` in the parent module.)
+/// `AUCTION_PAIRS_PER_ROW` in `super::sparse`.)
 pub(crate) const MAX_ADDED_PER_ROW: usize = 8;
 /// Points per leaf of the weighted tree (at most 64: a leaf's hits are the bits of a
 /// `u64`, [`WeightedTree::leaf_hits`]). 32 until the leaves' test lost its branches;

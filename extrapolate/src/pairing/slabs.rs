@@ -254,7 +254,7 @@ fn seam_offsets(states: &[SlabState]) -> Vec<i64> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{cost::CostScale, sparse, PairingOptions};
+    use super::super::{cost::CostScale, sparse::solve as sparse, PairingOptions};
 
     /// A tube 400 diameters long, 4 × 4 particles across, whose t1 is its t0 moved by
     /// about a diameter along the axis with jitter: the transport of a long kiln. The
