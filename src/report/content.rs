@@ -280,6 +280,43 @@ pub fn document(inp: &Inputs) -> Document {
         text(what),
     ]));
 
+    extrapolated_section(&mut d, inp);
+    prediction_section(&mut d, inp);
+    match c {
+        Some(c) => {
+            errors_section(&mut d, c);
+            if let Some(size_classes) = &c.size_classes {
+                size_classes_section(&mut d, size_classes);
+            }
+        }
+        None => {
+            d.push(Block::Heading(2, "Errors".into()));
+            d.push(para(vec![text(
+                "No DEM reference was recorded, so nothing is judged here: the errors of Table 5 \
+                 need the complete DEM at the extrapolated t_k. Record the case with \
+                 --reference K (and --twins 2 to measure the DEM's own run-to-run spread, the \
+                 floor no extrapolation can beat) to compare.",
+            )]));
+        }
+    }
+    costs_section(&mut d, inp);
+    durations_section(&mut d, inp);
+    field_section(&mut d, inp);
+
+    d.push(Block::Heading(2, "Files".into()));
+    d.push(Block::List(
+        inp.plots.iter().map(|p| vec![link(*p, *p)]).collect(),
+    ));
+    d
+}
+
+/// What was extrapolated: the files, the case, the recording's settings and the
+/// extrapolation's.
+fn extrapolated_section(d: &mut Document, inp: &Inputs) {
+    let info = inp.info;
+    let c = inp.comparison;
+    let p = inp.prediction;
+    let case = case_name(info);
     // What was extrapolated.
     d.push(Block::Heading(2, "What was extrapolated".into()));
     let n_steps = info.sample_every;
@@ -291,44 +328,7 @@ pub fn document(inp: &Inputs) -> Document {
             "none".into()
         }
     };
-    let pairing_row = match &inp.extrapolation.roles {
-        Roles::Pairing(pairing) => {
-            let mean = Some(pairing.mean_distance_diameters);
-            let certified = Some(pairing.certified);
-            let seconds = pairing.seconds;
-            let symmetry = inp.extrapolation.symmetry;
-            row(
-                match symmetry {
-                    Symmetry::None => "Pairing of t0 and t1",
-                    Symmetry::AxialMirror => "Pairing of t1 and the mirror image of t0",
-                },
-                format!(
-                    "{}mean distance {} diameters; certified optimal: {}; computed in {} s",
-                    crate::extrapolation::symmetry_words(symmetry)
-                        .map_or(String::new(), |w| format!("{w}; ")),
-                    opt(mean, |m| sig(m, 4)),
-                    certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
-                    opt(seconds, secs),
-                ),
-            )
-        }
-        Roles::Path(path) => row(
-            "Recurrence path",
-            std::iter::once(crate::extrapolation::path_words(path))
-                .chain(
-                    crate::extrapolation::symmetry_words(inp.extrapolation.symmetry)
-                        .map(String::from),
-                )
-                .chain(path.pairings.iter().map(|p| {
-                    format!(
-                        "pairing {}",
-                        crate::extrapolation::path_pairing_words(p, inp.extrapolation.symmetry)
-                    )
-                }))
-                .collect::<Vec<_>>()
-                .join("; "),
-        ),
-    };
+    let pairing_row = roles_row(inp);
     let groups = if p.hot_particles + p.cold_particles > 0 {
         format!(
             "{} ({} initially hot, {} initially cold)",
@@ -448,34 +448,48 @@ pub fn document(inp: &Inputs) -> Document {
         .collect(),
         numeric: false,
     });
+}
 
-    prediction_section(&mut d, inp);
-    match c {
-        Some(c) => {
-            errors_section(&mut d, c);
-            if let Some(size_classes) = &c.size_classes {
-                size_classes_section(&mut d, size_classes);
-            }
+/// The table's row of the roles: the pairing, or the path through several recorded periods.
+fn roles_row(inp: &Inputs) -> Vec<String> {
+    match &inp.extrapolation.roles {
+        Roles::Pairing(pairing) => {
+            let mean = Some(pairing.mean_distance_diameters);
+            let certified = Some(pairing.certified);
+            let seconds = pairing.seconds;
+            let symmetry = inp.extrapolation.symmetry;
+            row(
+                match symmetry {
+                    Symmetry::None => "Pairing of t0 and t1",
+                    Symmetry::AxialMirror => "Pairing of t1 and the mirror image of t0",
+                },
+                format!(
+                    "{}mean distance {} diameters; certified optimal: {}; computed in {} s",
+                    crate::extrapolation::symmetry_words(symmetry)
+                        .map_or(String::new(), |w| format!("{w}; ")),
+                    opt(mean, |m| sig(m, 4)),
+                    certified.map_or("unknown", |b| if b { "yes" } else { "no" }),
+                    opt(seconds, secs),
+                ),
+            )
         }
-        None => {
-            d.push(Block::Heading(2, "Errors".into()));
-            d.push(para(vec![text(
-                "No DEM reference was recorded, so nothing is judged here: the errors of Table 5 \
-                 need the complete DEM at the extrapolated t_k. Record the case with \
-                 --reference K (and --twins 2 to measure the DEM's own run-to-run spread, the \
-                 floor no extrapolation can beat) to compare.",
-            )]));
-        }
+        Roles::Path(path) => row(
+            "Recurrence path",
+            std::iter::once(crate::extrapolation::path_words(path))
+                .chain(
+                    crate::extrapolation::symmetry_words(inp.extrapolation.symmetry)
+                        .map(String::from),
+                )
+                .chain(path.pairings.iter().map(|p| {
+                    format!(
+                        "pairing {}",
+                        crate::extrapolation::path_pairing_words(p, inp.extrapolation.symmetry)
+                    )
+                }))
+                .collect::<Vec<_>>()
+                .join("; "),
+        ),
     }
-    costs_section(&mut d, inp);
-    durations_section(&mut d, inp);
-    field_section(&mut d, inp);
-
-    d.push(Block::Heading(2, "Files".into()));
-    d.push(Block::List(
-        inp.plots.iter().map(|p| vec![link(*p, *p)]).collect(),
-    ));
-    d
 }
 
 /// The prediction over all extrapolated periods: its plots and a table at the first, a
