@@ -157,7 +157,55 @@ pub fn write_with(
         Vec::new()
     };
 
-    let costs = match (recording.costs(), extrapolation.costs()) {
+    let costs = cost_table(recording, extrapolation);
+
+    let mut svgs = draw_plots(dir, recording, &pred, comparison, &dem_points, &costs)?;
+    let field = field_snap.map(|k| {
+        let dem_k = dem.iter().find(|s| s.index == k);
+        match (dem_k, &field_extra) {
+            (Some(dem_k), Some(extra)) => {
+                svgs.push((
+                    FIELD_SVG,
+                    drawn(
+                        dir,
+                        FIELD_SVG,
+                        plots::field(dem_k, extra, k, pred.drum_radius),
+                    )?,
+                ));
+                Ok::<_, anyhow::Error>(Ok(k))
+            }
+            (None, _) => Ok(Err(format!("{rec_path} has no DEM snapshot at t_{k}"))),
+            (_, None) => Ok(Err(format!("{extra_path} has no snapshot at t_{k}"))),
+        }
+    });
+    let field = field.transpose()?;
+
+    let doc = content::document(&content::Inputs {
+        recording_path: rec_path.clone(),
+        extrapolation_path: extrapolation.path().display().to_string(),
+        info,
+        extrapolation: extrapolation.info(),
+        summary: recording.summary(),
+        prediction: &pred,
+        comparison,
+        costs,
+        field,
+        plots: svgs.iter().map(|(name, _)| *name).collect(),
+    });
+
+    commit(dir, &svgs, &doc)
+}
+
+/// The costs of Table 6, or why there are none: a recording or extrapolation written with
+/// `--reproducible` has no wall times.
+fn cost_table(
+    recording: &RecordingReader,
+    extrapolation: &ExtrapolationReader,
+) -> std::result::Result<CostTable, String> {
+    let info = recording.info();
+    let rec_path = recording.path().display().to_string();
+    let extra_path = extrapolation.path().display().to_string();
+    match (recording.costs(), extrapolation.costs()) {
         (Some(rc), Some(ec)) => {
             let pairing_seconds = extrapolation.info().roles.pairing_seconds();
             Ok(CostTable::new(
@@ -175,37 +223,48 @@ pub fn write_with(
         (_, None) => Err(format!(
             "{extra_path} has no costs record (written with --reproducible, which leaves out the wall times)"
         )),
-    };
+    }
+}
 
+/// A plot drawn, or why not, naming its file.
+fn drawn(dir: &Path, name: &str, r: Result<String>) -> Result<String> {
+    r.with_context(|| format!("{}: cannot draw the plot", dir.join(name).display()))
+}
+
+/// The report's plots, each with its file name, but the field at the last compared `t_k`.
+fn draw_plots(
+    dir: &Path,
+    recording: &RecordingReader,
+    pred: &Prediction,
+    comparison: Option<&Comparison>,
+    dem_points: &[Vec<prediction::Point>],
+    costs: &std::result::Result<CostTable, String>,
+) -> Result<Vec<(&'static str, String)>> {
+    let info = recording.info();
     let mut svgs: Vec<(&'static str, String)> = Vec::new();
-    let plot = |name: &str, r: Result<String>| {
-        r.with_context(|| format!("{}: cannot draw the plot", dir.join(name).display()))
-    };
+    let plot = |name: &str, r: Result<String>| drawn(dir, name, r);
     svgs.push((
         BED_MEAN_SVG,
-        plot(BED_MEAN_SVG, plots::bed_mean(&pred, comparison))?,
+        plot(BED_MEAN_SVG, plots::bed_mean(pred, comparison))?,
     ));
     if pred.has_groups() {
         svgs.push((
             MEANS_SVG,
-            plot(MEANS_SVG, plots::group_means(&pred, comparison))?,
+            plot(MEANS_SVG, plots::group_means(pred, comparison))?,
         ));
     }
     if pred.wall_heat().is_some() {
         svgs.push((
             WALL_HEAT_SVG,
-            plot(WALL_HEAT_SVG, plots::wall_heat(&pred, comparison))?,
+            plot(WALL_HEAT_SVG, plots::wall_heat(pred, comparison))?,
         ));
     }
     svgs.push((
         SPREAD_SVG,
-        plot(SPREAD_SVG, plots::spread(&pred, &dem_points))?,
+        plot(SPREAD_SVG, plots::spread(pred, dem_points))?,
     ));
     if pred.has_groups() {
-        svgs.push((
-            LACEY_SVG,
-            plot(LACEY_SVG, plots::lacey(&pred, &dem_points))?,
-        ));
+        svgs.push((LACEY_SVG, plot(LACEY_SVG, plots::lacey(pred, dem_points))?));
     }
     let panels: Vec<(&tdex_format::Snapshot, String)> = pred
         .fields
@@ -234,7 +293,7 @@ pub fn write_with(
                 plot(SEGREGATION_SVG, plots::segregation(size_classes))?,
             ));
         }
-        if let Ok(t) = &costs {
+        if let Ok(t) = costs {
             svgs.push((
                 SPEEDUP_SVG,
                 plot(SPEEDUP_SVG, plots::error_vs_speedup(c, t))?,
@@ -254,37 +313,18 @@ pub fn write_with(
             )?,
         ));
     }
-    let field = field_snap.map(|k| {
-        let dem_k = dem.iter().find(|s| s.index == k);
-        match (dem_k, &field_extra) {
-            (Some(dem_k), Some(extra)) => {
-                svgs.push((
-                    FIELD_SVG,
-                    plot(FIELD_SVG, plots::field(dem_k, extra, k, pred.drum_radius))?,
-                ));
-                Ok::<_, anyhow::Error>(Ok(k))
-            }
-            (None, _) => Ok(Err(format!("{rec_path} has no DEM snapshot at t_{k}"))),
-            (_, None) => Ok(Err(format!("{extra_path} has no snapshot at t_{k}"))),
-        }
-    });
-    let field = field.transpose()?;
+    Ok(svgs)
+}
 
-    let doc = content::document(&content::Inputs {
-        recording_path: rec_path.clone(),
-        extrapolation_path: extrapolation.path().display().to_string(),
-        info,
-        extrapolation: extrapolation.info(),
-        summary: recording.summary(),
-        prediction: &pred,
-        comparison,
-        costs,
-        field,
-        plots: svgs.iter().map(|(name, _)| *name).collect(),
-    });
-
+/// Writes the plots and the document together (each to a temporary file, renamed once all
+/// are written), then removes what an older report in `dir` had and this one has not.
+fn commit(
+    dir: &Path,
+    svgs: &[(&'static str, String)],
+    doc: &document::Document,
+) -> Result<Vec<PathBuf>> {
     let mut set = OutputSet::new();
-    for (name, svg) in &svgs {
+    for (name, svg) in svgs {
         set.add(&dir.join(name), svg.as_bytes())?;
     }
     set.add(&dir.join(MARKDOWN), doc.markdown().as_bytes())?;
