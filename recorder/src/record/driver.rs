@@ -402,7 +402,7 @@ fn drive(
     };
     let mut parting = Parting::of(opts, &outputs.snapshots);
     run.recorded_periods(sim, dem, opts, &mut outputs, &mut parting, progress)?;
-    let main_stage_seconds = run.past_t1(sim, opts, &mut outputs, &parting, progress)?;
+    let main_stage_seconds = run.past_t1(sim, opts, &mut outputs, &mut parting, progress)?;
     run.finish(dem, sim, outputs, main_stage_seconds)
 }
 
@@ -457,7 +457,8 @@ impl Parting {
         parting
     }
 
-    /// The run's snapshot `t_k`, just written: kept if the twins need it.
+    /// The run's snapshot `t_k`, just written (recorded or reference): kept if the twins need
+    /// it.
     fn note(&mut self, snapshot: &Snapshot) {
         if !self.with_twins {
             return;
@@ -715,7 +716,7 @@ impl<'s> RunState<'s> {
         sim: &mut Simulation,
         opts: &RecordOptions,
         outputs: &mut Outputs,
-        parting: &Parting,
+        parting: &mut Parting,
         progress: &mut dyn FnMut(Phase, u64, u64),
     ) -> Result<Option<BTreeMap<String, f64>>, RecordError> {
         if !matches!(self.stage, Stage::Reference { .. } | Stage::Twin { .. }) {
@@ -726,7 +727,6 @@ impl<'s> RunState<'s> {
             Some(j) => Some(j.sync()?),
             None => None,
         };
-        let mut dem_next = parting.dem_next.clone();
         let mut past_t1 = PastT1 {
             opts,
             saver: self.saver.as_mut(),
@@ -734,7 +734,6 @@ impl<'s> RunState<'s> {
             run_at_t0: &outputs.run_at_t0,
             sampler: &outputs.samplers[0],
             at_t1: self.at_t1.as_ref(),
-            parting,
             elapsed: self.elapsed.clone(),
             began: Instant::now(),
         };
@@ -743,7 +742,7 @@ impl<'s> RunState<'s> {
             snapshots: &mut outputs.snapshots,
         };
         if let Stage::Reference { period, done } = self.stage {
-            past_t1.reference(sim, (period, done), &mut written, &mut dem_next, progress)?;
+            past_t1.reference(sim, (period, done), &mut written, parting, progress)?;
             if let Some(t1) = past_t1.at_t1 {
                 main_stage_seconds = Some(stage_seconds(sim));
                 *sim = twin_of(t1, 1);
@@ -756,9 +755,9 @@ impl<'s> RunState<'s> {
         }
         if let Stage::Twin { twin, period, done } = self.stage {
             let from = (twin, period, done);
-            past_t1.twins(sim, from, &mut written, dem_next.as_ref(), progress)?;
+            past_t1.twins(sim, from, &mut written, parting, progress)?;
         }
-        self.elapsed = past_t1.elapsed.clone();
+        self.elapsed = past_t1.elapsed;
         Ok(main_stage_seconds)
     }
 
@@ -832,7 +831,6 @@ struct PastT1<'a, 's> {
     run_at_t0: &'a RunAtT0,
     sampler: &'a ContactSampler,
     at_t1: Option<&'a Simulation>,
-    parting: &'a Parting,
     /// Elapsed times when the stage (re)started.
     elapsed: Elapsed,
     began: Instant,
@@ -846,17 +844,16 @@ struct Written<'o> {
 }
 
 impl PastT1<'_, '_> {
-    /// The run's own reference periods from `from` (period, steps done) on; its snapshot
-    /// `t_(s+1)` goes to `dem_next`, for the twins to be checked against.
+    /// The run's own reference periods from `from` (period, steps done) on; each snapshot
+    /// is noted in `parting`, for the twins.
     fn reference(
         &mut self,
         sim: &mut Simulation,
         from: (u32, u64),
         written: &mut Written,
-        dem_next: &mut Option<Snapshot>,
+        parting: &mut Parting,
         progress: &mut dyn FnMut(Phase, u64, u64),
     ) -> Result<(), RecordError> {
-        let parting = self.parting;
         let sinks = &mut *written.sinks;
         self.periods(
             sim,
@@ -868,9 +865,7 @@ impl PastT1<'_, '_> {
                 for sink in sinks.iter_mut() {
                     sink.writer.write_snapshot(snapshot)?;
                 }
-                if snapshot.index == parting.at + 1 && parting.with_twins {
-                    *dem_next = Some(snapshot.clone());
-                }
+                parting.note(snapshot);
                 Ok(())
             },
         )?;
@@ -879,19 +874,18 @@ impl PastT1<'_, '_> {
     }
 
     /// The DEM twins from `from` (twin, period, steps done) on, each from the engine at
-    /// `t_s`; a twin's first own snapshot must differ from the run's, `dem_next`.
+    /// `t_s`; a twin's first own snapshot must differ from the run's (`parting`).
     fn twins(
         &mut self,
         sim: &mut Simulation,
         (first, first_period, done): (u32, u32, u64),
         written: &mut Written,
-        dem_next: Option<&Snapshot>,
+        parting: &Parting,
         progress: &mut dyn FnMut(Phase, u64, u64),
     ) -> Result<(), RecordError> {
         let t1 = self.at_t1.ok_or_else(|| {
             RecordError::Settings("the twins' start at t1 is not in the checkpoint".into())
         })?;
-        let parting = self.parting;
         for twin in first..=self.opts.twins {
             if twin != first {
                 *sim = twin_of(t1, twin);
@@ -923,7 +917,7 @@ impl PastT1<'_, '_> {
                 progress,
                 &mut |period, snapshot| {
                     if period + 1 == parting.at {
-                        check_twin_differs(twin, snapshot, dem_next)?;
+                        check_twin_differs(twin, snapshot, parting.dem_next.as_ref())?;
                     }
                     for sink in sinks.iter_mut() {
                         sink.writer.write_twin_snapshot(twin, snapshot)?;
