@@ -24,7 +24,7 @@ const AXIAL_K_DEN: usize = 3;
 const AXIAL_SAMPLE: usize = 16;
 
 /// Certificate searches made on the auction's potentials, each followed by more
-/// auction on the enlarged graph (see `sparse`).
+/// auction on the enlarged graph (see `Bed::certify_on_auction`).
 const AUCTION_ROUNDS: usize = 2;
 
 /// With the certificate, the first auction pauses at its initial ε divided by this for
@@ -148,6 +148,19 @@ struct Bed<'a> {
     t: Instant,
 }
 
+/// The candidate graph and what the warm start reads off it.
+struct Candidates {
+    graph: candidates::Graph,
+    k0: usize,
+    /// The mean axial transport and the mean cheapest pair cost (sampled, then on the
+    /// whole graph), in length units.
+    shift: f64,
+    rho_sampled: f64,
+    rho: f64,
+    /// The auction's first ε.
+    eps0: i64,
+}
+
 /// The solve in progress: the candidate graph, the assignment with its potentials, the
 /// certificate's tree once built, and the work done.
 struct Solve {
@@ -240,11 +253,9 @@ impl<'a> Bed<'a> {
         AUCTION_BIDS_PER_ROW * self.n() as u64
     }
 
-    /// The candidate graph and the warm start: the row reduction, then an ε-scaling
-    /// auction (on axial slabs when `allow_slabs` and the bed calls for them); k doubled
-    /// once if the auction stopped on a graph without a perfect matching. Returns the
-    /// solve and the number of slabs (1: none).
-    fn warm_start(&self, allow_slabs: bool) -> (Solve, usize) {
+    /// The candidate graph, with k raised for a bed with a large axial transport, and what
+    /// the warm start reads off it.
+    fn candidate_graph(&self) -> Candidates {
         let (t, n, opts, scale) = (self.t, self.n(), self.opts, self.scale);
         let (x0, x1) = (&self.x0[..], &self.x1[..]);
         let shift = self.axial.mean_abs_shift();
@@ -266,13 +277,13 @@ impl<'a> Bed<'a> {
             AXIAL_SAMPLE,
             scale,
         ) * scale.unit();
-        let mut k0 = if shift > rho_sampled {
+        let k0 = if shift > rho_sampled {
             k_axial
         } else {
             k_plain
         };
         trace!(t, "sampled mean cheapest pair");
-        let mut graph = self.knn_graph(k0);
+        let graph = self.knn_graph(k0);
         trace!(t, "knn k {k0}");
         if trace_on() {
             // A pass over the graph (a few milliseconds on 80 000 rows, in the stamps that
@@ -290,8 +301,32 @@ impl<'a> Bed<'a> {
             "axial transport (mean |shift| {shift:.3e}, mean cheapest pair {rho:.3e}, sampled \
              {rho_sampled:.3e}) + knn k {k0} + graph"
         );
+        Candidates {
+            eps0: cheapest.initial_eps(),
+            graph,
+            k0,
+            shift,
+            rho_sampled,
+            rho,
+        }
+    }
+
+    /// The warm start on the candidate graph: the row reduction, then an ε-scaling
+    /// auction (on axial slabs when `allow_slabs` and the bed calls for them); k doubled
+    /// once if the auction stopped on a graph without a perfect matching. Returns the
+    /// solve and the number of slabs (1: none).
+    fn warm_start(&self, allow_slabs: bool) -> (Solve, usize) {
+        let (t, n, opts, scale) = (self.t, self.n(), self.opts, self.scale);
+        let (x0, x1) = (&self.x0[..], &self.x1[..]);
+        let Candidates {
+            mut graph,
+            mut k0,
+            shift,
+            rho_sampled,
+            rho,
+            mut eps0,
+        } = self.candidate_graph();
         let v_axial = self.axial.potentials(x0, rho, scale.unit());
-        let mut eps0 = cheapest.initial_eps();
         let budget = self.budget();
         // Warm start: the row reduction, then an ε-scaling auction. The auction moves the
         // holes left by the row reduction (the long-range part of the transport) far more
