@@ -344,8 +344,17 @@ fn an_extrapolation_of_another_recording_of_the_run_is_compared_at_the_shared_in
 /// The tiny drum recorded for τ = a quarter revolution with 3 reference periods and `twins`
 /// DEM twins, extrapolated 3 periods: (recording, extrapolation) in `dir`.
 fn record_twins_and_extrapolate(dir: &Path, twins: u32) -> (PathBuf, PathBuf) {
+    record_case_twins_and_extrapolate(dir, TINY_CASE, twins)
+}
+
+/// [`record_twins_and_extrapolate`] of the case `case_text`.
+fn record_case_twins_and_extrapolate(
+    dir: &Path,
+    case_text: &str,
+    twins: u32,
+) -> (PathBuf, PathBuf) {
     let case = dir.join("case.toml");
-    std::fs::write(&case, TINY_CASE).unwrap();
+    std::fs::write(&case, case_text).unwrap();
     let (run, extra) = (dir.join("run.mcap"), dir.join("extra.mcap"));
     let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
     let twins = twins.to_string();
@@ -546,6 +555,71 @@ fn with_three_dem_runs_each_run_is_judged_against_the_others() {
     assert!(
         text.contains("each DEM run judged the same way against the others: medians")
             && text.contains(&format!("{above} of the 3 above the extrapolation's")),
+        "{text}"
+    );
+    // an adiabatic bed keeps its bed mean: nothing to set apart
+    assert!(verdict.get("pattern").is_none(), "{verdict}");
+    assert!(v["periods"][0].get("pattern").is_none());
+    assert!(!text.contains("less its own bed mean"), "{text}");
+}
+
+/// A bed heated by its mantle is also measured on each field less its own bed mean, at every
+/// compared t_k for the extrapolation and for each DEM run in its seat, and the verdict says
+/// its median beside the runs'.
+#[test]
+fn a_heated_bed_is_also_measured_less_its_bed_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    let heated = TINY_CASE.replace(
+        "rotation_period = 2.0",
+        "rotation_period = 2.0\nwall_temperature = 350.0",
+    );
+    assert_ne!(heated, TINY_CASE);
+    let (run, extra) = record_case_twins_and_extrapolate(dir.path(), &heated, 2);
+    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
+    let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let verdict = &v["verdict"];
+    let compared: Vec<u64> = verdict["compared"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|k| k.as_u64().unwrap())
+        .collect();
+    assert!(!compared.is_empty(), "{verdict}");
+    let (mut pattern, mut differs) = (Vec::new(), false);
+    for p in v["periods"].as_array().unwrap() {
+        if !compared.contains(&p["k"].as_u64().unwrap()) {
+            continue;
+        }
+        let ratio = p["pattern"]["ratio_to_floor"]
+            .as_f64()
+            .unwrap_or_else(|| panic!("a heated bed's pattern at k = {}: {p}", p["k"]));
+        assert_eq!(
+            p["pattern"]["dem_runs_ratio_to_others"]
+                .as_array()
+                .map(Vec::len),
+            Some(3),
+            "{p}"
+        );
+        // the runs' bed means differ, so the pattern is not the field
+        differs |= (ratio - p["ratio_to_floor"].as_f64().unwrap()).abs() > 1e-9;
+        pattern.push(ratio);
+    }
+    assert!(differs, "{v}");
+    let median = tdex::compare::floor::median(&pattern).unwrap();
+    let judged = verdict["pattern"]["median_ratio"].as_f64().unwrap();
+    assert!((judged - median).abs() <= 1e-12 * median, "{verdict}");
+    assert_eq!(
+        verdict["pattern"]["dem_runs_median_ratio"]
+            .as_array()
+            .map(Vec::len),
+        Some(3)
+    );
+    let text = verdict["text"].as_str().unwrap();
+    assert!(
+        text.contains("each field less its own bed mean")
+            && text.contains("each DEM run's judged the same way"),
         "{text}"
     );
 }

@@ -125,10 +125,20 @@ pub fn floor(
     second: &[Option<f64>],
     departure: Departure,
 ) -> Option<Floor> {
-    if runs.len() < 2 {
+    let means: Vec<Vec<Option<f64>>> = runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
+    floor_of_means(&means, second, departure)
+}
+
+/// [`floor`] on the cell means already computed: `means[i]` of run `i` (the reference
+/// first), `second` of the second field.
+pub fn floor_of_means(
+    means: &[Vec<Option<f64>>],
+    second: &[Option<f64>],
+    departure: Departure,
+) -> Option<Floor> {
+    if means.len() < 2 {
         return None;
     }
-    let means: Vec<Vec<Option<f64>>> = runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
     // distance[i][j] between runs i and j (both halves filled)
     let n = means.len();
     let mut distance = vec![vec![0.0; n]; n];
@@ -183,6 +193,44 @@ pub fn floor(
         runs_ratio_to_others,
         runs_outside_others_range,
     })
+}
+
+/// The floor of the pattern: [`floor_of_means`] on each field's cell means less its own bed
+/// mean (`run_bed_means[i]` of run `i`, `second_bed_mean`). A bed heated through a wall
+/// heats at a rate the recorded periods set; less its bed mean, a field that heats
+/// uniformly a little too fast or too slowly is as near the DEM runs as the pattern of its
+/// heat allows, so the two floors tell a miss in the bed mean from one in where the heat is.
+pub fn pattern_floor(
+    means: &[Vec<Option<f64>>],
+    run_bed_means: &[f64],
+    second: &[Option<f64>],
+    second_bed_mean: f64,
+    departure: Departure,
+) -> Option<PatternFloor> {
+    let less = |cells: &[Option<f64>], bed_mean: f64| -> Vec<Option<f64>> {
+        cells.iter().map(|m| m.map(|m| m - bed_mean)).collect()
+    };
+    let runs: Vec<Vec<Option<f64>>> = means
+        .iter()
+        .zip(run_bed_means)
+        .map(|(m, &bed_mean)| less(m, bed_mean))
+        .collect();
+    let f = floor_of_means(&runs, &less(second, second_bed_mean), departure)?;
+    Some(PatternFloor {
+        ratio_to_floor: f.ratio_to_floor,
+        dem_runs_ratio_to_others: f.runs_ratio_to_others,
+    })
+}
+
+/// The floor of each field less its own bed mean, at one `t_k` ([`pattern_floor`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PatternFloor {
+    /// The second field's mean distance to the DEM runs over theirs to each other.
+    pub ratio_to_floor: Option<f64>,
+    /// Each DEM run judged as the second field is, against the others (empty with fewer
+    /// than three runs, and then left out of the JSON).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dem_runs_ratio_to_others: Vec<Option<f64>>,
 }
 
 /// The median of `values` (the mean of the middle two for an even count); `None` if empty.
@@ -381,6 +429,37 @@ mod tests {
         let f = floor(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
         assert_eq!(f.runs_ratio_to_others[2], None);
         assert_eq!(f.runs_ratio_to_others[0], Some(0.5));
+    }
+
+    #[test]
+    fn less_the_bed_mean_a_field_heated_uniformly_too_fast_scores_as_its_pattern() {
+        // three DEM runs' cell means, bed means 25, 26 and 27 K (two cells of equal weight)
+        let runs = vec![
+            vec![Some(15.0), Some(35.0)],
+            vec![Some(17.0), Some(35.0)],
+            vec![Some(19.0), Some(35.0)],
+        ];
+        let beds = [25.0, 26.0, 27.0];
+        // the second field: the middle run's pattern, 3 K warmer everywhere
+        let warm = [Some(20.0), Some(38.0)];
+        let field = floor_of_means(&runs, &warm, Departure::WithTheTwins).unwrap();
+        let pattern = pattern_floor(&runs, &beds, &warm, 29.0, Departure::WithTheTwins).unwrap();
+        // on the field it is far from the runs (4, 3 and 2 K against their 4/3 K apart);
+        // less the bed means the runs are (−10, 10), (−9, 9), (−8, 8), again 4/3 K apart on
+        // average, and the second field (−9, 9) is the middle one: 1, 0 and 1 K from them
+        assert_eq!(field.ratio_to_floor, Some(3.0 / (4.0 / 3.0)));
+        assert_eq!(pattern.ratio_to_floor, Some((2.0 / 3.0) / (4.0 / 3.0)));
+        // each DEM run judged the same way: the middle run as the second field, the outer
+        // two 1.5 from the others against their 1
+        assert_eq!(
+            pattern.dem_runs_ratio_to_others,
+            vec![Some(1.5 / 1.0), Some(1.0 / 2.0), Some(1.5 / 1.0)]
+        );
+        // a field whose heat is elsewhere, (−4, 4) less its bed mean: the pattern sees it
+        // (6, 5 and 4 K from the runs)
+        let moved = [Some(25.0), Some(33.0)];
+        let off = pattern_floor(&runs, &beds, &moved, 29.0, Departure::WithTheTwins).unwrap();
+        assert_eq!(off.ratio_to_floor, Some(5.0 / (4.0 / 3.0)));
     }
 
     #[test]

@@ -137,6 +137,11 @@ pub struct PeriodComparison {
     pub dem_runs_hot_mean: Vec<f64>,
     pub dem_runs_cold_mean: Vec<f64>,
     pub dem_runs_bed_mean: Vec<f64>,
+    /// With a wall that conducts heat (the bed mean moves): the same ratios on each field
+    /// less its own bed mean, its pattern ([`floor::pattern_floor`]); null otherwise, and
+    /// then left out of the JSON.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<floor::PatternFloor>,
     /// The extrapolation had not yet left the recorded run at this `t_k`: along a
     /// recurrence path the periods before the first jump are the recording's own
     /// continuation from `t1` (`t2 … tP'` with `P'` recorded periods), so its snapshot is
@@ -675,6 +680,7 @@ mod tests {
                 dem_runs_hot_mean: Vec::new(),
                 dem_runs_cold_mean: Vec::new(),
                 dem_runs_bed_mean: vec![310.2],
+                pattern: None,
                 within_recording: false,
             })
             .collect();

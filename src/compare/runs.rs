@@ -281,7 +281,26 @@ impl DemRuns {
                 temp: &s.temp,
             })
             .collect();
-        let floor = floor::floor(&self.cells, &runs, &extra_means, self.departure);
+        let run_means: Vec<Vec<Option<f64>>> = runs
+            .iter()
+            .map(|r| self.cells.means(r.pos, r.temp))
+            .collect();
+        let floor = floor::floor_of_means(&run_means, &extra_means, self.departure);
+        let bed_mean_extra = metrics::bed_mean(&after.radius, &after.temp);
+        // a wall that conducts heat: the bed mean moves at a rate the recorded periods set,
+        // so the same distances are also measured on each field less its own bed mean
+        let run_bed_means: Vec<f64> = std::iter::once(bed_mean_dem)
+            .chain(at_k.iter().map(|s| metrics::bed_mean(&s.radius, &s.temp)))
+            .collect();
+        let pattern = self.wall_temperature.and_then(|_| {
+            floor::pattern_floor(
+                &run_means,
+                &run_bed_means,
+                &extra_means,
+                bed_mean_extra,
+                self.departure,
+            )
+        });
         // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
         // has no snapshot at t1, where it is the reference
         let floor_energy_error = self
@@ -318,7 +337,7 @@ impl DemRuns {
             cold_mean_dem: cold_dem,
             cold_mean_extra: cold_extra,
             bed_mean_dem,
-            bed_mean_extra: metrics::bed_mean(&after.radius, &after.temp),
+            bed_mean_extra,
             contrast: scale,
             floor_eps_abs: floor.as_ref().map(|f| f.floor_eps_abs),
             floor_eps_abs_min: floor.as_ref().map(|f| f.floor_eps_abs_min),
@@ -343,10 +362,8 @@ impl DemRuns {
                 .zip(&at_k_groups)
                 .filter_map(|(s, g)| group_means(g, &s.temp).1)
                 .collect(),
-            dem_runs_bed_mean: at_k
-                .iter()
-                .map(|s| metrics::bed_mean(&s.radius, &s.temp))
-                .collect(),
+            dem_runs_bed_mean: run_bed_means[1..].to_vec(),
+            pattern,
             within_recording,
         })
     }

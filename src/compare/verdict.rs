@@ -91,8 +91,42 @@ pub struct Verdict {
     pub means_in_seat: Vec<SeatMeans>,
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub dem_runs_means: Vec<SeatMeans>,
+    /// With a wall that conducts heat: the same median on each field less its own bed mean
+    /// ([`PeriodComparison::pattern`]), beside the DEM runs'; null otherwise (left out of
+    /// the JSON). Not part of the judgement, which is on the field: it says whether a miss
+    /// is in the bed mean or in where the heat is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pattern: Option<PatternVerdict>,
     /// The verdict in words.
     pub text: String,
+}
+
+/// The median ratio of each field less its own bed mean, over the compared `t_k`.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PatternVerdict {
+    pub median_ratio: f64,
+    /// Each DEM run's, judged against the others the same way (empty with fewer than three
+    /// runs, and then left out of the JSON).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub dem_runs_median_ratio: Vec<f64>,
+}
+
+impl PatternVerdict {
+    /// Over the `compared` `t_k` of `periods`; `None` unless every one of them has a pattern
+    /// ratio.
+    fn of(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize) -> Option<Self> {
+        let ratios = periods
+            .iter()
+            .filter(|p| compared.contains(&p.k))
+            .map(|p| p.pattern.as_ref()?.ratio_to_floor)
+            .collect::<Option<Vec<f64>>>()?;
+        Some(Self {
+            median_ratio: median(&ratios)?,
+            dem_runs_median_ratio: runs_medians(periods, compared, dem_runs, |p| {
+                p.pattern.as_ref().map(|f| &f.dem_runs_ratio_to_others)
+            }),
+        })
+    }
 }
 
 /// A number with two significant decimals at most, without float noise.
@@ -222,7 +256,10 @@ impl Verdict {
         let (error, spread) = means_error_and_spread(&periods, groups);
         let (means_in_seat, dem_runs_means) = means_in_seats(&periods, groups, dem_runs);
         let median_ratio = median(&ratios);
-        let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs);
+        let dem_runs_median_ratio = runs_medians(&periods, &compared, dem_runs, |p| {
+            Some(&p.dem_runs_ratio_to_others)
+        });
+        let pattern = PatternVerdict::of(&periods, &compared, dem_runs);
         let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
             Vec::new()
         } else {
@@ -255,6 +292,7 @@ impl Verdict {
             dem_runs_outside_share,
             means_in_seat,
             dem_runs_means,
+            pattern,
             text: String::new(),
         };
         verdict.text = verdict.words(&setting);
@@ -287,6 +325,26 @@ impl Verdict {
             (Some(e), None) => format!("; {what} within {} of the DEM's", kelvin(e)),
             _ => String::new(),
         };
+        // the pattern beside the field, where a heated wall moves the bed mean
+        let pattern = self.pattern.as_ref().map_or(String::new(), |p| {
+            let runs = &p.dem_runs_median_ratio;
+            let dem = if runs.is_empty() {
+                String::new()
+            } else {
+                let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                format!(
+                    ", each DEM run's judged the same way {}–{}",
+                    num(lo),
+                    num(hi)
+                )
+            };
+            format!(
+                "; each field less its own bed mean (where the heat is, apart from how fast the \
+                 bed heats): median ratio {}{dem}",
+                beside_one(p.median_ratio)
+            )
+        });
         let range = match (self.ratio_min, self.ratio_max) {
             (Some(lo), Some(hi)) if self.compared.len() > 1 => format!("{}–{}", num(lo), num(hi)),
             (Some(only), _) => num(only),
@@ -323,7 +381,7 @@ impl Verdict {
         match (self.passes, self.median_ratio) {
             (Some(true), Some(m)) => format!(
                 "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}\
+                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}{pattern}\
                  {runs_note}",
                 instants(&self.compared, self.compared.len()),
                 beside_one(m),
@@ -367,7 +425,7 @@ impl Verdict {
                 };
                 format!(
                     "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}\
+                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}{pattern}\
                      {runs_note}",
                     instants(&self.compared, self.compared.len()),
                     if m > 1.0 {
@@ -408,18 +466,27 @@ impl Verdict {
     }
 }
 
-/// Each DEM run's median of [`PeriodComparison::dem_runs_ratio_to_others`] over the
-/// `compared` `t_k` (empty unless all `dem_runs` ≥ 3 runs were judged at every one of them,
-/// so that each median is over the same instants as the second field's).
-fn runs_medians(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize) -> Vec<f64> {
+/// Each DEM run's median of its `ratios` at a `t_k` ([`PeriodComparison::
+/// dem_runs_ratio_to_others`], or the pattern's) over the `compared` `t_k` (empty unless all
+/// `dem_runs` ≥ 3 runs were judged at every one of them, so that each median is over the
+/// same instants as the second field's).
+fn runs_medians(
+    periods: &[&PeriodComparison],
+    compared: &[u32],
+    dem_runs: usize,
+    ratios: impl Fn(&PeriodComparison) -> Option<&Vec<Option<f64>>>,
+) -> Vec<f64> {
     if dem_runs < 3 || compared.is_empty() {
         return Vec::new();
     }
-    let at: Vec<&Vec<Option<f64>>> = periods
+    let Some(at) = periods
         .iter()
         .filter(|p| compared.contains(&p.k))
-        .map(|p| &p.dem_runs_ratio_to_others)
-        .collect();
+        .map(|p| ratios(p))
+        .collect::<Option<Vec<&Vec<Option<f64>>>>>()
+    else {
+        return Vec::new();
+    };
     (0..dem_runs)
         .map(|run| {
             at.iter()
@@ -643,6 +710,7 @@ mod tests {
             dem_runs_hot_mean: vec![310.04],
             dem_runs_cold_mean: vec![300.01],
             dem_runs_bed_mean: vec![305.0],
+            pattern: None,
             within_recording: false,
         }
     }

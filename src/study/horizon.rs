@@ -539,6 +539,27 @@ fn pooled_table(s: &HorizonStudy) -> String {
             or_dash(d.dem_runs_means_error_to_spread),
         );
     }
+    // a bed heated through a wall: the same medians on each field less its own bed mean
+    if s.pooled
+        .iter()
+        .any(|r| r.draws.pattern_median_ratio.is_some())
+    {
+        t += "\neach field less its own bed mean, over the draws (where the heat is, apart from \
+              how fast the bed heats; it informs, the verdict is on the field):\n";
+        t += &format!(
+            "{:<w$} {:>14} {:>22}\n",
+            "run", "median ratio", "DEM run: median ratio"
+        );
+        for r in &s.pooled {
+            let d = &r.draws;
+            t += &format!(
+                "{:<w$} {:>14} {:>22}\n",
+                r.label(),
+                or_dash(d.pattern_median_ratio),
+                or_dash(d.dem_runs_pattern_median_ratio),
+            );
+        }
+    }
     t.push('\n');
     for r in &s.pooled {
         t += &format!("{} over the draws: {}\n", r.label(), r.draws.text);
