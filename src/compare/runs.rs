@@ -287,11 +287,11 @@ impl DemRuns {
             .collect();
         let floor = floor::floor_of_means(&run_means, &extra_means, self.departure);
         let bed_mean_extra = metrics::bed_mean(&after.radius, &after.temp);
-        // a wall that conducts heat: the bed mean moves at a rate the recorded periods set,
-        // so the same distances are also measured on each field less its own bed mean
         let run_bed_means: Vec<f64> = std::iter::once(bed_mean_dem)
             .chain(at_k.iter().map(|s| metrics::bed_mean(&s.radius, &s.temp)))
             .collect();
+        // a wall that conducts heat: the bed mean moves at a rate the recorded periods set,
+        // so the same distances are also measured on each field less its own bed mean
         let pattern = self.wall_temperature.and_then(|_| {
             floor::pattern_floor(
                 &run_means,
