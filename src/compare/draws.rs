@@ -60,6 +60,13 @@ impl MeanSe {
     }
 }
 
+/// A figure of the extrapolation beside a DEM run's judged in its seat.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Beside<T> {
+    pub extrapolation: T,
+    pub dem_run: T,
+}
+
 /// One draw's figures, from its comparison.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Draw {
@@ -89,12 +96,10 @@ pub struct Draw {
     pub means_error_to_spread: Option<f64>,
     pub dem_runs_means_error_to_spread: Option<f64>,
     /// With a wall that conducts heat: the median ratio of each field less its own bed mean
-    /// ([`super::verdict::PatternVerdict`]), the extrapolation's and the mean of the DEM
+    /// ([`super::verdict::PatternVerdict`]), the extrapolation's beside the mean of the DEM
     /// runs' in the seat; null otherwise (left out of the JSON).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub pattern_median_ratio: Option<f64>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub dem_runs_pattern_median_ratio: Option<f64>,
+    pub pattern: Option<Beside<f64>>,
     /// Whether the means are the hot and cold group means (else the bed mean).
     #[serde(skip)]
     pub groups: bool,
@@ -146,11 +151,12 @@ impl Draw {
                 .ok_or_else(not_judged)?,
             means_error_to_spread: error_to_spread(&v.means_in_seat),
             dem_runs_means_error_to_spread: error_to_spread(&v.dem_runs_means),
-            pattern_median_ratio: v.pattern.as_ref().map(|p| p.median_ratio),
-            dem_runs_pattern_median_ratio: v
-                .pattern
-                .as_ref()
-                .and_then(|p| mean(&p.dem_runs_median_ratio)),
+            pattern: v.pattern.as_ref().and_then(|p| {
+                Some(Beside {
+                    extrapolation: p.median_ratio,
+                    dem_run: mean(&p.dem_runs_median_ratio)?,
+                })
+            }),
             groups: c.contrast == ContrastKind::HotCold,
         })
     }
@@ -203,13 +209,11 @@ pub struct Draws {
     pub means_error_to_spread: Option<MeanSe>,
     pub dem_runs_means_error_to_spread: Option<MeanSe>,
     /// With a wall that conducts heat, the median ratio of each field less its own bed mean
-    /// over the draws, the extrapolation's and a DEM run's in the seat (null unless every
-    /// draw has both, and then left out of the JSON). Not part of the judgement: it tells a
+    /// over the draws, the extrapolation's beside a DEM run's in the seat (null unless every
+    /// draw has it, and then left out of the JSON). Not part of the judgement: it tells a
     /// miss in the bed mean from one in where the heat is.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub pattern_median_ratio: Option<MeanSe>,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub dem_runs_pattern_median_ratio: Option<MeanSe>,
+    pub pattern: Option<Beside<MeanSe>>,
     /// Each draw's figures, in the order given.
     pub each: Vec<Draw>,
     /// The judgement in words.
@@ -259,13 +263,12 @@ impl Draws {
         };
         let means_error_to_spread = over_some(|d| d.means_error_to_spread);
         let dem_runs_means_error_to_spread = over_some(|d| d.dem_runs_means_error_to_spread);
-        let (pattern_median_ratio, dem_runs_pattern_median_ratio) = match (
-            over_some(|d| d.pattern_median_ratio),
-            over_some(|d| d.dem_runs_pattern_median_ratio),
-        ) {
-            (Some(x), Some(dem)) => (Some(x), Some(dem)),
-            _ => (None, None),
-        };
+        let pattern = over_some(|d| d.pattern.map(|p| p.extrapolation)).and_then(|x| {
+            Some(Beside {
+                extrapolation: x,
+                dem_run: over_some(|d| d.pattern.map(|p| p.dem_run))?,
+            })
+        });
         let passes = median_ratio_within && outside_share_within && means_within_spread;
         let mut pooled = Draws {
             draws: each.len(),
@@ -286,8 +289,7 @@ impl Draws {
             dem_runs_means_outside_share,
             means_error_to_spread,
             dem_runs_means_error_to_spread,
-            pattern_median_ratio,
-            dem_runs_pattern_median_ratio,
+            pattern,
             each,
             text: String::new(),
         };
@@ -367,18 +369,14 @@ impl Draws {
             percent_plus_minus(self.means_outside_share_in_seat),
             percent_plus_minus(self.dem_runs_means_outside_share),
         );
-        let pattern_words = match (
-            self.pattern_median_ratio,
-            self.dem_runs_pattern_median_ratio,
-        ) {
-            (Some(x), Some(dem)) => format!(
+        let pattern_words = self.pattern.map_or(String::new(), |p| {
+            format!(
                 "; each field less its own bed mean (where the heat is, apart from how fast the \
                  bed heats): mean median ratio {} against {} for a DEM run",
-                plus_minus(x),
-                plus_minus(dem)
-            ),
-            _ => String::new(),
-        };
+                plus_minus(p.extrapolation),
+                plus_minus(p.dem_run)
+            )
+        });
         format!(
             "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
              {means_words}{pattern_words}",
@@ -425,15 +423,12 @@ impl Draws {
                 plus_minus(dem)
             );
         }
-        if let (Some(x), Some(dem)) = (
-            self.pattern_median_ratio,
-            self.dem_runs_pattern_median_ratio,
-        ) {
+        if let Some(p) = self.pattern {
             s += &format!(
                 "{:<40} {:>16} {:>20}\n",
                 "median ratio less the bed mean",
-                plus_minus(x),
-                plus_minus(dem)
+                plus_minus(p.extrapolation),
+                plus_minus(p.dem_run)
             );
         }
         s
@@ -530,8 +525,7 @@ mod tests {
             dem_runs_means_outside_share: 0.0,
             means_error_to_spread: Some(0.5),
             dem_runs_means_error_to_spread: Some(0.5),
-            pattern_median_ratio: None,
-            dem_runs_pattern_median_ratio: None,
+            pattern: None,
             groups: true,
         }
     }
@@ -703,14 +697,16 @@ mod tests {
     #[test]
     fn the_pattern_is_pooled_beside_a_dem_runs_where_every_draw_has_it_and_does_not_judge() {
         let heated = |median: f64, pattern: f64| Draw {
-            pattern_median_ratio: Some(pattern),
-            dem_runs_pattern_median_ratio: Some(1.0),
+            pattern: Some(Beside {
+                extrapolation: pattern,
+                dem_run: 1.0,
+            }),
             groups: false,
             ..draw(median, 0.3, 1.0, 0.3)
         };
         let draws = vec![heated(1.5, 0.98), heated(1.7, 1.0), heated(1.6, 1.02)];
         let pooled = Draws::pool(draws.clone()).unwrap();
-        let pattern = pooled.pattern_median_ratio.unwrap();
+        let pattern = pooled.pattern.unwrap().extrapolation;
         assert!((pattern.mean - 1.0).abs() < 1e-12, "{pattern:?}");
         assert!((pattern.standard_error - 0.02 / 3f64.sqrt()).abs() < 1e-12);
         // the field decides: far above the bar, whatever the pattern
@@ -726,10 +722,9 @@ mod tests {
         assert!(pooled.table().contains("median ratio less the bed mean"));
         // a draw without it (an adiabatic bed's): nothing pooled, nothing said
         let mut mixed = draws;
-        mixed[1].pattern_median_ratio = None;
+        mixed[1].pattern = None;
         let pooled = Draws::pool(mixed).unwrap();
-        assert_eq!(pooled.pattern_median_ratio, None);
-        assert_eq!(pooled.dem_runs_pattern_median_ratio, None);
+        assert_eq!(pooled.pattern, None);
         assert!(!pooled.text.contains("less its own bed mean"));
         assert!(!pooled.table().contains("less the bed mean"));
     }

@@ -540,10 +540,7 @@ fn pooled_table(s: &HorizonStudy) -> String {
         );
     }
     // a bed heated through a wall: the same medians on each field less its own bed mean
-    if s.pooled
-        .iter()
-        .any(|r| r.draws.pattern_median_ratio.is_some())
-    {
+    if s.pooled.iter().any(|r| r.draws.pattern.is_some()) {
         t += "\neach field less its own bed mean, over the draws (where the heat is, apart from \
               how fast the bed heats; it informs, the verdict is on the field):\n";
         t += &format!(
@@ -555,8 +552,8 @@ fn pooled_table(s: &HorizonStudy) -> String {
             t += &format!(
                 "{:<w$} {:>14} {:>22}\n",
                 r.label(),
-                or_dash(d.pattern_median_ratio),
-                or_dash(d.dem_runs_pattern_median_ratio),
+                or_dash(d.pattern.map(|p| p.extrapolation)),
+                or_dash(d.pattern.map(|p| p.dem_run)),
             );
         }
     }
