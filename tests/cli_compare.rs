@@ -480,23 +480,29 @@ fn a_twin_gives_the_floor_and_the_ratio_at_every_period() {
 /// three. With three runs the floor's mean, smallest and largest distance give all three
 /// pair distances, so the runs' ratios are known from them whatever the order of the runs:
 /// the run opposite pair (b, c) scores (d_ab + d_ac) / 2 / d_bc.
-#[test]
-fn with_three_dem_runs_each_run_is_judged_against_the_others() {
-    let dir = tempfile::tempdir().unwrap();
-    let (run, extra) = record_twins_and_extrapolate(dir.path(), 2);
+/// `tdex compare RUN EXTRA --cells 20 --json`: the output and the compared `t_k` (some).
+fn compare_on_20_cells(run: &Path, extra: &Path) -> (serde_json::Value, Vec<u64>) {
     let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
     let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
-    assert_eq!(v["dem_runs"], 3);
-    let verdict = &v["verdict"];
-    let compared: Vec<u64> = verdict["compared"]
+    let compared: Vec<u64> = v["verdict"]["compared"]
         .as_array()
         .unwrap()
         .iter()
         .map(|k| k.as_u64().unwrap())
         .collect();
-    assert!(!compared.is_empty(), "{verdict}");
+    assert!(!compared.is_empty(), "{}", v["verdict"]);
+    (v, compared)
+}
+
+#[test]
+fn with_three_dem_runs_each_run_is_judged_against_the_others() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, extra) = record_twins_and_extrapolate(dir.path(), 2);
+    let (v, compared) = compare_on_20_cells(&run, &extra);
+    assert_eq!(v["dem_runs"], 3);
+    let verdict = &v["verdict"];
     let mut per_run: Vec<Vec<f64>> = vec![Vec::new(); 3];
     for p in v["periods"].as_array().unwrap() {
         let num = |key: &str| p[key].as_f64().unwrap();
@@ -575,18 +581,8 @@ fn a_heated_bed_is_also_measured_less_its_bed_mean() {
     );
     assert_ne!(heated, TINY_CASE);
     let (run, extra) = record_case_twins_and_extrapolate(dir.path(), &heated, 2);
-    let (run_s, extra_s) = (run.to_str().unwrap(), extra.to_str().unwrap());
-    let o = run_tdex(&["compare", run_s, extra_s, "--cells", "20", "--json"]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let (v, compared) = compare_on_20_cells(&run, &extra);
     let verdict = &v["verdict"];
-    let compared: Vec<u64> = verdict["compared"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|k| k.as_u64().unwrap())
-        .collect();
-    assert!(!compared.is_empty(), "{verdict}");
     let (mut pattern, mut differs) = (Vec::new(), false);
     for p in v["periods"].as_array().unwrap() {
         if !compared.contains(&p["k"].as_u64().unwrap()) {
