@@ -2,7 +2,7 @@
 //! of one case (the reference and its twins), and the extrapolation's distance to those runs
 //! measured the same way, so that the extrapolation is judged as one more run would be.
 
-use super::metrics::{eps_abs, Cells};
+use super::metrics::eps_abs;
 use serde::Serialize;
 
 /// The DEM runs' spread and the extrapolation's place in it, at one `t_k`.
@@ -36,12 +36,6 @@ pub struct Floor {
 /// `to_runs` to them no larger than the largest distance `max` between two of them.
 pub fn within(to_runs: f64, max: f64) -> bool {
     to_runs <= max
-}
-
-/// The cell means of one field: positions and temperatures in the same order.
-pub struct Field<'a> {
-    pub pos: &'a [[f64; 3]],
-    pub temp: &'a [f64],
 }
 
 /// Where the second field left the reference, against where the twins parted from it: which
@@ -115,23 +109,11 @@ impl Departure {
     }
 }
 
-/// The floor of `runs` (at least two DEM runs at the same `t_k`, the reference first) and
-/// the distance of `second` (cell means already computed) to those its `departure` names, on
-/// `cells`. `None` with fewer than two runs or when no cell holds particles of both fields
-/// of some pair.
+/// The floor of the DEM runs whose cell means are `means` (at least two at the same `t_k`,
+/// the reference first) and the distance of the second field's, `second`, to those its
+/// `departure` names. `None` with fewer than two runs or when no cell holds particles of
+/// both fields of some pair.
 pub fn floor(
-    cells: &Cells,
-    runs: &[Field],
-    second: &[Option<f64>],
-    departure: Departure,
-) -> Option<Floor> {
-    let means: Vec<Vec<Option<f64>>> = runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
-    floor_of_means(&means, second, departure)
-}
-
-/// [`floor`] on the cell means already computed: `means[i]` of run `i` (the reference
-/// first), `second` of the second field.
-pub fn floor_of_means(
     means: &[Vec<Option<f64>>],
     second: &[Option<f64>],
     departure: Departure,
@@ -195,7 +177,7 @@ pub fn floor_of_means(
     })
 }
 
-/// The floor of the pattern: [`floor_of_means`] on each field's cell means less its own bed
+/// The floor of the pattern: [`floor`] on each field's cell means less its own bed
 /// mean (`run_bed_means[i]` of run `i`, `second_bed_mean`). A bed heated through a wall
 /// heats at a rate the recorded periods set; less its bed mean, a field that heats
 /// uniformly a little too fast or too slowly is as near the DEM runs as the pattern of its
@@ -215,7 +197,7 @@ pub fn pattern_floor(
         .zip(run_bed_means)
         .map(|(m, &bed_mean)| less(m, bed_mean))
         .collect();
-    let f = floor_of_means(&runs, &less(second, second_bed_mean), departure)?;
+    let f = floor(&runs, &less(second, second_bed_mean), departure)?;
     Some(PatternFloor {
         ratio_to_floor: f.ratio_to_floor,
         dem_runs_ratio_to_others: f.runs_ratio_to_others,
@@ -248,6 +230,25 @@ pub fn median(values: &[f64]) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compare::metrics::Cells;
+
+    /// One field's particles: positions and temperatures in the same order.
+    struct Field<'a> {
+        pos: &'a [[f64; 3]],
+        temp: &'a [f64],
+    }
+
+    /// [`floor`] of `runs` on `cells`.
+    fn floor_of(
+        cells: &Cells,
+        runs: &[Field],
+        second: &[Option<f64>],
+        departure: Departure,
+    ) -> Option<Floor> {
+        let means: Vec<Vec<Option<f64>>> =
+            runs.iter().map(|r| cells.means(r.pos, r.temp)).collect();
+        floor(&means, second, departure)
+    }
 
     #[test]
     fn the_departure_names_the_runs_measured_to_and_a_late_parting() {
@@ -342,7 +343,7 @@ mod tests {
             temp: &temp,
         };
         let extra = [Some(16.0), Some(35.0)];
-        let f = floor(&cells(), &[dem, twin], &extra, Departure::WithTheTwins).unwrap();
+        let f = floor_of(&cells(), &[dem, twin], &extra, Departure::WithTheTwins).unwrap();
         assert_eq!(f.floor_eps_abs, 0.0);
         assert_eq!(f.floor_eps_abs_max, 0.0);
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
@@ -368,28 +369,28 @@ mod tests {
         // one more run, measured to both
         let with = Departure::WithTheTwins;
         // the extrapolation halfway between them: 0.5 K from each
-        let f = floor(&cells(), &runs, &[Some(16.0), Some(35.0)], with).unwrap();
+        let f = floor_of(&cells(), &runs, &[Some(16.0), Some(35.0)], with).unwrap();
         assert_eq!(f.floor_eps_abs, 1.0);
         assert_eq!((f.floor_eps_abs_min, f.floor_eps_abs_max), (1.0, 1.0));
         assert_eq!(f.eps_abs_to_dem_runs, 0.5);
         assert_eq!(f.ratio_to_floor, Some(0.5));
         assert!(within(f.eps_abs_to_dem_runs, f.floor_eps_abs_max));
         // a field 3 K off in the first cell is farther than the runs are from each other
-        let far = floor(&cells(), &runs, &[Some(19.0), Some(35.0)], with).unwrap();
+        let far = floor_of(&cells(), &runs, &[Some(19.0), Some(35.0)], with).unwrap();
         assert_eq!(far.eps_abs_to_dem_runs, 1.5);
         assert_eq!(far.ratio_to_floor, Some(1.5));
         assert!(!within(far.eps_abs_to_dem_runs, far.floor_eps_abs_max));
         // one run alone has no floor
         assert_eq!(
-            floor(&cells(), &runs[..1], &[Some(15.0), Some(35.0)], with),
+            floor_of(&cells(), &runs[..1], &[Some(15.0), Some(35.0)], with),
             None
         );
         // the field of the DEM itself (an extrapolation still on the reference): half the
         // floor to both runs, the whole floor to the twin alone
         let on_dem = [Some(15.0), Some(35.0)];
-        let all = floor(&cells(), &runs, &on_dem, with).unwrap();
+        let all = floor_of(&cells(), &runs, &on_dem, with).unwrap();
         assert_eq!(all.ratio_to_floor, Some(0.5));
-        let twins = floor(&cells(), &runs, &on_dem, Departure::of(Some(2), 1)).unwrap();
+        let twins = floor_of(&cells(), &runs, &on_dem, Departure::of(Some(2), 1)).unwrap();
         assert_eq!(twins.eps_abs_to_dem_runs, 1.0);
         assert_eq!(twins.ratio_to_floor, Some(1.0));
         assert_eq!(twins.floor_eps_abs, all.floor_eps_abs);
@@ -406,7 +407,7 @@ mod tests {
         ];
         let runs: Vec<Field> = temps.iter().map(|t| Field { pos: &POS, temp: t }).collect();
         let on_first = [Some(15.0), Some(35.0)];
-        let f = floor(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
+        let f = floor_of(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
         // run 0: to the others (1 + 5) / 2 = 3, their distance 4; run 1: (1 + 4) / 2 over 5;
         // run 2: (5 + 4) / 2 over 1
         assert_eq!(
@@ -420,13 +421,13 @@ mod tests {
         assert_eq!(f.floor_eps_abs, 10.0 / 3.0);
         assert_eq!(f.eps_abs_to_dem_runs, 2.0);
         // two runs: neither has a floor of others to be judged against
-        let two = floor(&cells(), &runs[..2], &on_first, Departure::WithTheTwins).unwrap();
+        let two = floor_of(&cells(), &runs[..2], &on_first, Departure::WithTheTwins).unwrap();
         assert!(two.runs_ratio_to_others.is_empty());
         assert!(two.runs_outside_others_range.is_empty());
         // identical others give no ratio, not an infinite one
         let same = [temps[0], temps[0], temps[1]];
         let runs: Vec<Field> = same.iter().map(|t| Field { pos: &POS, temp: t }).collect();
-        let f = floor(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
+        let f = floor_of(&cells(), &runs, &on_first, Departure::WithTheTwins).unwrap();
         assert_eq!(f.runs_ratio_to_others[2], None);
         assert_eq!(f.runs_ratio_to_others[0], Some(0.5));
     }
@@ -442,7 +443,7 @@ mod tests {
         let beds = [25.0, 26.0, 27.0];
         // the second field: the middle run's pattern, 3 K warmer everywhere
         let warm = [Some(20.0), Some(38.0)];
-        let field = floor_of_means(&runs, &warm, Departure::WithTheTwins).unwrap();
+        let field = floor(&runs, &warm, Departure::WithTheTwins).unwrap();
         let pattern = pattern_floor(&runs, &beds, &warm, 29.0, Departure::WithTheTwins).unwrap();
         // on the field it is far from the runs (4, 3 and 2 K against their 4/3 K apart);
         // less the bed means the runs are (−10, 10), (−9, 9), (−8, 8), again 4/3 K apart on

@@ -1,7 +1,7 @@
 //! The stages of one comparison: the DEM runs read and checked, the second field opened, and
 //! each compared `t_k` measured against them ([`super::compare_runs`] drives them in turn).
 
-use super::floor::{self, Field};
+use super::floor;
 use super::metrics::{self, Cells};
 use super::{
     check_same_instants, same_run, CompareError, ContrastKind, GroupMeans, HotCold,
@@ -253,10 +253,22 @@ impl DemRuns {
         within_recording: bool,
     ) -> Result<PeriodComparison> {
         let (k_before, k) = (dem_before.index, dem_after.index);
-        let dem_means = self.cells.means(&dem_after.pos, &dem_after.temp);
+        // the DEM runs at t_k: the reference, then every further run that reached t_k
+        let (at_k, at_k_groups): (Vec<&Snapshot>, Vec<&HotCold>) = self
+            .others
+            .iter()
+            .zip(&self.run_groups)
+            .filter_map(|(o, g)| Some((o.iter().find(|s| s.index == k)?, g)))
+            .unzip();
+        // each run's cell means, the reference's first, found once for the errors, the
+        // floor and the pattern
+        let run_means: Vec<Vec<Option<f64>>> = std::iter::once(dem_after)
+            .chain(at_k.iter().copied())
+            .map(|s| self.cells.means(&s.pos, &s.temp))
+            .collect();
         let extra_means = metrics::cell_means(second_cells, &after.temp, self.cells.len());
-        let (eps_abs, cells_used) =
-            metrics::eps_abs(&dem_means, &extra_means).ok_or(CompareError::NoSharedCell { k })?;
+        let (eps_abs, cells_used) = metrics::eps_abs(&run_means[0], &extra_means)
+            .ok_or(CompareError::NoSharedCell { k })?;
         let (hot_dem, cold_dem) = group_means(&self.groups, &dem_after.temp);
         let extra_after = metrics::by_id(&after.id, &after.temp);
         let (hot_extra, cold_extra) = group_means(second_groups, &extra_after);
@@ -267,25 +279,7 @@ impl DemRuns {
             ContrastKind::None => None,
         }
         .filter(|s| *s > 0.0);
-        // the DEM runs at t_k: the reference, then every further run that reached t_k
-        let (at_k, at_k_groups): (Vec<&Snapshot>, Vec<&HotCold>) = self
-            .others
-            .iter()
-            .zip(&self.run_groups)
-            .filter_map(|(o, g)| Some((o.iter().find(|s| s.index == k)?, g)))
-            .unzip();
-        let runs: Vec<Field> = std::iter::once(dem_after)
-            .chain(at_k.iter().copied())
-            .map(|s| Field {
-                pos: &s.pos,
-                temp: &s.temp,
-            })
-            .collect();
-        let run_means: Vec<Vec<Option<f64>>> = runs
-            .iter()
-            .map(|r| self.cells.means(r.pos, r.temp))
-            .collect();
-        let floor = floor::floor_of_means(&run_means, &extra_means, self.departure);
+        let floor = floor::floor(&run_means, &extra_means, self.departure);
         let bed_mean_extra = metrics::bed_mean(&after.radius, &after.temp);
         let run_bed_means: Vec<f64> = std::iter::once(bed_mean_dem)
             .chain(at_k.iter().map(|s| metrics::bed_mean(&s.radius, &s.temp)))
