@@ -161,7 +161,7 @@ pub struct ClassComparison {
 }
 
 /// Min and max of `values`, NaN left out (None when nothing is left).
-fn min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+pub(crate) fn min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     values
         .filter(|v| !v.is_nan())
         .fold(None, |acc, v| match acc {

@@ -327,18 +327,16 @@ impl Verdict {
         };
         // the pattern beside the field, where a heated wall moves the bed mean
         let pattern = self.pattern.as_ref().map_or(String::new(), |p| {
-            let runs = &p.dem_runs_median_ratio;
-            let dem = if runs.is_empty() {
-                String::new()
-            } else {
-                let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-                format!(
-                    ", each DEM run's judged the same way {}–{}",
-                    num(lo),
-                    num(hi)
-                )
-            };
+            let dem = super::classes::min_max(p.dem_runs_median_ratio.iter().copied()).map_or(
+                String::new(),
+                |(lo, hi)| {
+                    format!(
+                        ", each DEM run's judged the same way {}–{}",
+                        num(lo),
+                        num(hi)
+                    )
+                },
+            );
             format!(
                 "; each field less its own bed mean (where the heat is, apart from how fast the \
                  bed heats): median ratio {}{dem}",
