@@ -15,7 +15,9 @@ period's own (t_0 → t_1, the one the replay repeats) beside the DEM reference'
 (t_k → t_k+1 after t_1: their mean and standard deviation, how much one period's varies),
 then at lags of 20 and 100 periods the
 DEM's (the mean over the reference and its twins) beside the extrapolation's and their
-ratio. In the extrapolation a particle stands where the role it plays stands.
+ratio; last, over all the beds, how much one DEM run's dispersion over a single window of the
+lag (windows that do not overlap) scatters: what a rate measured on so many DEM periods could
+be trusted to. In the extrapolation a particle stands where the role it plays stands.
 """
 import sys
 
@@ -33,13 +35,22 @@ def by_id(run):
     return {k: np.sort(points, order="id") for k, points in run.items()}
 
 
+def window(run, first, last, lag, diameter):
+    """Mean square axial displacement from t_first to t_last, over `lag` (d² per period)."""
+    step = (run[last]["y"] - run[first]["y"]) / diameter
+    return float(np.mean((step - step.mean()) ** 2)) / lag
+
+
 def dispersion(run, ks, lag, diameter):
-    """Mean square axial displacement over `lag` periods, over `lag` (d² per period)."""
-    values = []
-    for i in range(0, len(ks) - lag, START_EVERY):
-        step = (run[ks[i + lag]]["y"] - run[ks[i]]["y"]) / diameter
-        values.append(np.mean((step - step.mean()) ** 2) / lag)
+    """The mean over starts every START_EVERY t_k of the dispersion over `lag` periods."""
+    values = [window(run, ks[i], ks[i + lag], lag, diameter)
+              for i in range(0, len(ks) - lag, START_EVERY)]
     return float(np.mean(values)) if values else float("nan")
+
+
+def windows(run, ks, lag, diameter):
+    """The dispersion over each window of `lag` periods, windows end to end from the first t_k."""
+    return [window(run, ks[i], ks[i + lag], lag, diameter) for i in range(0, len(ks) - lag, lag)]
 
 
 def bed(rec_path, extra_path):
@@ -53,13 +64,14 @@ def bed(rec_path, extra_path):
     own = float(np.mean((step - step.mean()) ** 2))
     reference = by_id(dem)
     periods = [k for k in sorted(reference) if k >= 1 and k + 1 in reference]
-    one_period = [dispersion(reference, [k, k + 1], 1, diameter) for k in periods]
-    by_lag = {}
+    one_period = [window(reference, k, k + 1, 1, diameter) for k in periods]
+    by_lag, single = {}, {}
     for lag in LAGS:
         if len(ks) > lag:
             dem_value = np.mean([dispersion(r, ks, lag, diameter) for r in runs])
             by_lag[lag] = (dem_value, dispersion(extra, ks, lag, diameter))
-    return own, (np.mean(one_period), np.std(one_period, ddof=1)), by_lag
+            single[lag] = [w for r in runs for w in windows(r, ks, lag, diameter)]
+    return own, (np.mean(one_period), np.std(one_period, ddof=1)), by_lag, single
 
 
 def main(paths):
@@ -70,8 +82,11 @@ def main(paths):
     print("bed                          recorded  DEM period     " + "  ".join(
         f"lag {lag:3d}: DEM   extra  ratio" for lag in LAGS))
     ratios = {lag: [] for lag in LAGS}
+    single = {lag: [] for lag in LAGS}
     for rec, extra in zip(paths[::2], paths[1::2]):
-        own, (period_mean, period_sd), by_lag = bed(rec, extra)
+        own, (period_mean, period_sd), by_lag, bed_windows = bed(rec, extra)
+        for lag, values in bed_windows.items():
+            single[lag].extend(values)
         cells = []
         for lag in LAGS:
             if lag in by_lag:
@@ -87,6 +102,11 @@ def main(paths):
             print(f"lag {lag}: the extrapolation's over the DEM's {values.min():.2f}–"
                   f"{values.max():.2f}, its rms distance from 1 "
                   f"{np.sqrt(np.mean((values - 1) ** 2)):.2f}")
+        values = np.array(single[lag])
+        if len(values) > 1:
+            print(f"lag {lag}: one DEM run over one window of {lag} periods: {values.mean():.3f} d² "
+                  f"per period, standard deviation {values.std(ddof=1):.3f} "
+                  f"({100 * values.std(ddof=1) / values.mean():.0f} %, {len(values)} windows)")
 
 
 if __name__ == "__main__":
