@@ -639,10 +639,9 @@ fn yardstick_words(
     compared: usize,
     outside: usize,
 ) -> String {
-    match (median_ratio, runs_medians) {
-        (Some(m), runs) if !runs.is_empty() => {
-            let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let runs = runs_medians;
+    match (median_ratio, super::classes::min_max(runs.iter().copied())) {
+        (Some(m), Some((lo, hi))) => {
             let above = runs.iter().filter(|&&r| r > m).count();
             let n = compared;
             let counts: Vec<usize> = outside_shares
