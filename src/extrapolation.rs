@@ -206,13 +206,22 @@ pub fn boundary_lines(boundary: Boundary, pools: &[FreshPool]) -> Vec<String> {
             pool,
             bin_diameters,
             cell_diameters,
+            cap_zone_diameters,
             seed,
         } => format!(
             "fresh drift: each jump draws one of {pool} pairings in which the period's axial \
              drift ({}-diameter bins, {}-diameter cells of the cross-section) is moved along \
-             the axis (seed {seed})",
+             the axis{} (seed {seed})",
             sig(bin_diameters),
-            sig(cell_diameters)
+            sig(cell_diameters),
+            if cap_zone_diameters > 0.0 {
+                format!(
+                    ", but within {} diameters of an end cap, where it is kept",
+                    sig(cap_zone_diameters)
+                )
+            } else {
+                String::new()
+            }
         ),
     };
     let mut lines = vec![what];

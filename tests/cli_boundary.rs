@@ -1,7 +1,7 @@
 //! `tdex extrapolate --boundary`: the fresh boundary maps conserve the heat over 500 periods,
 //! are the same bytes on any thread count and a function of the seed, say what they did, and
 //! work along a recurrence path; `--boundary exact` is the paper's method to the byte; the
-//! fresh maps' options are refused without them.
+//! fresh maps' options are refused without them, and a cap zone in a section without caps.
 
 use crate::cli_run::TINY_CASE;
 use crate::util::{run_tdex, tdex_ok};
@@ -134,6 +134,37 @@ fn fresh_maps_conserve_the_heat_over_500_periods_and_are_a_function_of_the_seed(
     assert_eq!(drift["boundary"]["kind"], "fresh_drift");
     assert_eq!(drift["boundary"]["bin_diameters"], 1.5);
     assert_eq!(drift["boundary"]["cell_diameters"], 3.0);
+    // no cap zone is no key, as in the files written before it
+    assert!(drift["boundary"].get("cap_zone_diameters").is_none());
+    let zoned_output = adiabatic_dir.path().join("zoned.mcap");
+    let zoned = extrapolate(
+        &adiabatic,
+        &zoned_output,
+        &[
+            "--periods",
+            "500",
+            "--boundary",
+            "fresh-drift",
+            "--boundary-cap-zone",
+            "1",
+        ],
+    );
+    assert_eq!(zoned["boundary"]["cap_zone_diameters"], 1.0);
+    let (t1, end) = (
+        zoned["total_heat_t1"].as_f64().unwrap(),
+        zoned["total_heat_end"].as_f64().unwrap(),
+    );
+    assert!(
+        ((end - t1) / t1).abs() < 1e-12,
+        "cap zone: {t1} J, then {end} J"
+    );
+    // a zone draws other maps than none (the tiny drum is 6 diameters long: a 1-diameter
+    // zone keeps the drift of its end bins)
+    assert!(
+        std::fs::read(&zoned_output).unwrap()
+            != std::fs::read(adiabatic_dir.path().join("fresh-drift1.mcap")).unwrap(),
+        "the cap zone changed nothing"
+    );
 
     // another seed draws other maps; the same seed the same bytes
     let seeded = |seed: &str, name: &str| {
@@ -248,15 +279,22 @@ fn the_exact_boundary_is_the_paper_method_to_the_byte_and_the_fresh_options_need
         ["--boundary-pool", "4"],
         ["--boundary-cell", "2"],
         ["--boundary-bin", "2"],
+        ["--boundary-cap-zone", "2"],
     ] {
         refused(
             &flag,
             "with --boundary exact there is one pairing per start",
         );
     }
+    for flag in ["--boundary-bin", "--boundary-cap-zone"] {
+        refused(
+            &["--boundary", "fresh-steps", flag, "2"],
+            "--boundary-bin and --boundary-cap-zone set the drift of --boundary fresh-drift",
+        );
+    }
     refused(
-        &["--boundary", "fresh-steps", "--boundary-bin", "2"],
-        "--boundary-bin sets the bins of --boundary fresh-drift",
+        &["--boundary", "fresh-drift", "--boundary-cap-zone=-1"],
+        "give a distance in particle diameters ≥ 0",
     );
     let out = run_tdex(&extrapolate_args(
         &run,
@@ -303,4 +341,43 @@ fn a_path_through_two_recorded_periods_draws_fresh_maps_into_each_start() {
             "{kind} along the path depends on the threads"
         );
     }
+}
+
+#[test]
+fn a_cap_zone_is_refused_in_a_section_without_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = dir.path().join("section.toml");
+    let section = TINY_CASE.replace(
+        "rotation_period = 2.0",
+        "rotation_period = 2.0\nend_caps = \"periodic\"",
+    );
+    std::fs::write(&case, section).unwrap();
+    let run = dir.path().join("section.mcap");
+    tdex_ok(&[
+        "record",
+        case.to_str().unwrap(),
+        "-o",
+        run.to_str().unwrap(),
+        "--tau",
+        "0.2",
+        "--reproducible",
+    ]);
+    let out_path = dir.path().join("zoned.mcap");
+    let flags = ["--periods", "3", "--boundary", "fresh-drift"];
+    let out = run_tdex(&extrapolate_args(
+        &run,
+        &out_path,
+        &[&flags[..], &["--boundary-cap-zone", "2"]].concat(),
+    ));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("section.mcap: its section is periodic along the axis and has no end caps")
+            && err.contains("a cap zone of 2 diameters keeps nothing"),
+        "{err}"
+    );
+    assert!(!out_path.exists());
+    // without the zone the drift is moved round the section
+    extrapolate(&run, &out_path, &flags);
+    assert!(out_path.exists());
 }

@@ -31,6 +31,7 @@ use crate::ExtrapolateError;
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use std::collections::BTreeMap;
+use std::ops::Range;
 use tdex_format::extrapolation::FreshPool;
 use tdex_format::Snapshot;
 
@@ -45,6 +46,10 @@ pub const DEFAULT_CELL_DIAMETERS: f64 = 3.0;
 /// Length of the axial bins of the drift, in particle diameters: bins of 1 and 4 diameters
 /// move the mean median by at most 0.02 on eight beds of `axial_drum` over 100 periods.
 pub const DEFAULT_BIN_DIAMETERS: f64 = 2.0;
+/// How near an end cap the drift is kept rather than moved, in particle diameters: none by
+/// default, since a long drum's caps' drift is half fresh and keeping it repeats that half
+/// (docs/method.md#6-the-replay, "The drift at the end caps").
+pub const DEFAULT_CAP_ZONE_DIAMETERS: f64 = 0.0;
 
 /// The boundary maps an extrapolation asks for; the seed is the recurrence path's (the
 /// case's unless given), so that one seed names the whole extrapolation.
@@ -56,11 +61,13 @@ pub enum BoundaryMaps {
     /// particles ending in its `cell_diameters`-wide cell of the cross-section.
     FreshSteps { pool: u32, cell_diameters: f64 },
     /// A pool of `pool` pairings per start, the coarse axial drift (bins of `bin_diameters`
-    /// along the axis, cells of `cell_diameters` across) moved along the axis.
+    /// along the axis, cells of `cell_diameters` across) moved along the axis; the drift of
+    /// the bins within `cap_zone_diameters` of an end cap is kept (0: every bin's is moved).
     FreshDrift {
         pool: u32,
         bin_diameters: f64,
         cell_diameters: f64,
+        cap_zone_diameters: f64,
     },
 }
 
@@ -81,10 +88,12 @@ impl BoundaryMaps {
                 pool,
                 bin_diameters,
                 cell_diameters,
+                cap_zone_diameters,
             } => Boundary::FreshDrift {
                 pool,
                 bin_diameters,
                 cell_diameters,
+                cap_zone_diameters,
                 seed,
             },
         }
@@ -206,11 +215,23 @@ pub struct AxialDrift {
     bins: usize,
     cell: f64,
     axis: AxialEnds,
+    /// The bins whose drift is moved, among themselves: every bin, or those beyond the cap
+    /// zone (the drift within it, the caps' own circulation, is kept).
+    moved: Range<usize>,
     pub by_cell: BTreeMap<(i64, i64), Vec<f64>>,
 }
 
 impl AxialDrift {
-    pub fn of(start: &Snapshot, end: &Snapshot, bin: f64, cell: f64, axis: AxialEnds) -> Self {
+    /// The drift of the period `start` → `end`; between caps, the drift of the bins whose
+    /// centre is within `cap_zone` of an end of the bed is kept (0: none is).
+    pub fn of(
+        start: &Snapshot,
+        end: &Snapshot,
+        bin: f64,
+        cell: f64,
+        cap_zone: f64,
+        axis: AxialEnds,
+    ) -> Self {
         let extent = axis.span(&end.pos);
         let (bin, bins) = match axis {
             AxialEnds::Caps => (
@@ -224,12 +245,26 @@ impl AxialDrift {
                 (length / bins as f64, bins)
             }
         };
+        let moved = match axis {
+            AxialEnds::Caps if cap_zone > 0.0 => {
+                let centre = |b: usize| extent.0 + (b as f64 + 0.5) * bin;
+                let first = (0..bins).find(|&b| centre(b) >= extent.0 + cap_zone);
+                let last = (0..bins).rev().find(|&b| centre(b) <= extent.1 - cap_zone);
+                match (first, last) {
+                    (Some(first), Some(last)) if last >= first => first..last + 1,
+                    // the zones meet: the whole drift is the caps'
+                    _ => 0..0,
+                }
+            }
+            _ => 0..bins,
+        };
         let mut drift = Self {
             extent,
             bin,
             bins,
             cell,
             axis,
+            moved,
             by_cell: BTreeMap::new(),
         };
         for (key, members) in cross_section_cells(&end.pos, cell) {
@@ -259,18 +294,29 @@ impl AxialDrift {
 
     /// The end positions of one map with a fresh drift: each particle keeps its recorded end
     /// position but for its bin's drift, which becomes the drift of the bin a random offset
-    /// further along the axis (the same offset for the whole bed, wrapped around its extent),
-    /// so that the drift's pattern, and every particle's place among its neighbours, is the
-    /// recording's. Positions stay within the bed's extent at the end between caps, and
-    /// wrap in a periodic section.
+    /// further along the axis (the same offset for the whole bed, wrapped around the moved
+    /// bins), so that the drift's pattern, and every particle's place among its neighbours,
+    /// is the recording's. A bin in a cap zone keeps its own drift. Positions stay within the
+    /// bed's extent at the end between caps, and wrap in a periodic section.
     pub fn moved_ends(&self, end: &Snapshot, rng: &mut Xoshiro256PlusPlus) -> Vec<[f64; 3]> {
-        let offset = ((unit(rng) * self.bins as f64) as usize).min(self.bins - 1);
+        let Range {
+            start: first,
+            end: past,
+        } = self.moved;
+        let span = (past - first).max(1);
+        // one draw per map, whether or not any bin is moved: the later maps' draws stay put
+        let offset = ((unit(rng) * span as f64) as usize).min(span - 1);
         end.pos
             .iter()
             .map(|&[x, y, z]| {
                 let cell_drift = &self.by_cell[&cell_key(&[x, y, z], self.cell)];
                 let b = self.bin_of(y);
-                let moved = y + cell_drift[(b + offset) % self.bins] - cell_drift[b];
+                let source = if self.moved.contains(&b) {
+                    first + (b - first + offset) % span
+                } else {
+                    b
+                };
+                let moved = y + cell_drift[source] - cell_drift[b];
                 [x, self.axis.place(moved, self.extent), z]
             })
             .collect()
@@ -341,6 +387,7 @@ pub fn fresh_pool(
             pool,
             bin_diameters,
             cell_diameters,
+            cap_zone_diameters,
         } => (
             pool,
             Redraw::Drift(AxialDrift::of(
@@ -348,6 +395,7 @@ pub fn fresh_pool(
                 end,
                 bin_diameters * d,
                 cell_diameters * d,
+                cap_zone_diameters * d,
                 axis,
             )),
         ),
@@ -642,9 +690,9 @@ mod tests {
         let start = snapshot(0, bed.iter().map(|&[x, y, z]| [x, y - 30.0, z]).collect());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
         let end = banded_drift(&start, &mut rng, |y| pairing::wrap(y, length));
-        let odd = AxialDrift::of(&start, &end, 7.0, 4.0, axis);
+        let odd = AxialDrift::of(&start, &end, 7.0, 4.0, 0.0, axis);
         assert_eq!((odd.bins, odd.bin), (9, length / 9.0));
-        let recorded = AxialDrift::of(&start, &end, 2.0, 4.0, axis);
+        let recorded = AxialDrift::of(&start, &end, 2.0, 4.0, 0.0, axis);
         assert_eq!(recorded.bins, 30);
         // the recorded drift carries the ±0.8 pattern
         let cell0 = &recorded.by_cell[&(0, 0)];
@@ -676,7 +724,7 @@ mod tests {
         let start = snapshot(0, at([-1.0, 0.5, 3.0, 5.0]));
         let end = snapshot(1, at([0.0, 1.5, 2.5, 5.0]));
         // steps 1, 1, −0.5, 0 (mean 0.375); ends in bins 0, 0, 1, 2
-        let drift = AxialDrift::of(&start, &end, 2.0, 3.0, AxialEnds::Caps).by_cell;
+        let drift = AxialDrift::of(&start, &end, 2.0, 3.0, 0.0, AxialEnds::Caps).by_cell;
         assert_eq!(drift.len(), 1);
         let bins = &drift[&(0, 0)];
         let expected = [1.0 - 0.375, -0.5 - 0.375, 0.0 - 0.375];
@@ -695,7 +743,7 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
         let end = banded_drift(&start, &mut rng, |y| y.clamp(0.0, 60.0));
         let (bin, cell) = (2.0, 4.0);
-        let recorded = AxialDrift::of(&start, &end, bin, cell, AxialEnds::Caps);
+        let recorded = AxialDrift::of(&start, &end, bin, cell, 0.0, AxialEnds::Caps);
         let drift = &recorded.by_cell;
         let spread = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
         let mut offsets_seen = std::collections::BTreeSet::new();
@@ -735,6 +783,63 @@ mod tests {
         );
         // the recorded drift carries the ±0.8 pattern: each bin's drift is far from 0
         assert!(spread(&drift[&(0, 0)]) > 0.3, "{:?}", drift[&(0, 0)]);
+    }
+
+    #[test]
+    fn a_cap_zone_keeps_the_drift_near_the_caps_and_moves_the_middles_among_its_bins() {
+        let start = snapshot(0, random_bed(3000, (8.0, 60.0, 3.0), 7));
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
+        let end = banded_drift(&start, &mut rng, |y| y.clamp(0.0, 60.0));
+        let (bin, cell, zone) = (2.0, 4.0, 8.0);
+        let drift = AxialDrift::of(&start, &end, bin, cell, zone, AxialEnds::Caps);
+        let (lowest, highest) = axial_extent(&end.pos);
+        // the moved bins are those whose centre is at least `zone` from both ends of the bed
+        let centre = |b: usize| lowest + (b as f64 + 0.5) * bin;
+        for b in 0..drift.bins {
+            let inside = centre(b) >= lowest + zone && centre(b) <= highest - zone;
+            assert_eq!(drift.moved.contains(&b), inside, "bin {b}");
+        }
+        let mut middle_moved = false;
+        for _ in 0..6 {
+            let ends = drift.moved_ends(&end, &mut rng);
+            for (a, e) in end.pos.iter().enumerate() {
+                let b = drift.bin_of(e[1]);
+                let by = ends[a][1] - e[1];
+                if !drift.moved.contains(&b) {
+                    // y + drift[b] − drift[b]: the recorded end, to rounding
+                    assert_eq!([ends[a][0], ends[a][2]], [e[0], e[2]]);
+                    assert!(
+                        by.abs() < 1e-12,
+                        "a particle in a cap zone keeps its end: {by}"
+                    );
+                } else {
+                    // the drift it takes is a middle bin's: within the moved bins' range
+                    let cell_drift = &drift.by_cell[&cell_key(e, cell)];
+                    let taken = cell_drift[b] + by;
+                    let clamped = ends[a][1] <= lowest || ends[a][1] >= highest;
+                    assert!(
+                        clamped
+                            || drift
+                                .moved
+                                .clone()
+                                .any(|m| (cell_drift[m] - taken).abs() < 1e-9),
+                        "particle {a} took a drift no middle bin has"
+                    );
+                    middle_moved |= by.abs() > 1e-9;
+                }
+            }
+        }
+        assert!(middle_moved, "the middle's drift is moved");
+        // a zone reaching the middle from both caps keeps the whole drift: the recorded ends
+        let kept = AxialDrift::of(&start, &end, bin, cell, 31.0, AxialEnds::Caps);
+        assert!(kept.moved.is_empty());
+        let kept_ends = kept.moved_ends(&end, &mut rng);
+        for (moved, recorded) in kept_ends.iter().zip(&end.pos) {
+            assert!((moved[1] - recorded[1]).abs() < 1e-12);
+        }
+        // no zone moves every bin, as before there was one
+        let all = AxialDrift::of(&start, &end, bin, cell, 0.0, AxialEnds::Caps);
+        assert_eq!(all.moved, 0..all.bins);
     }
 
     #[test]

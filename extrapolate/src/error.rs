@@ -59,6 +59,16 @@ pub enum ExtrapolateError {
         recording.display()
     )]
     NoDrumAxis { recording: PathBuf },
+    /// A cap zone asked of a section periodic along its axis, which has no end caps.
+    #[error(
+        "{}: its section is periodic along the axis and has no end caps, so a cap zone of \
+         {cap_zone_diameters} diameters keeps nothing (the cap zone must be 0 there)",
+        recording.display()
+    )]
+    CapZoneWithoutCaps {
+        recording: PathBuf,
+        cap_zone_diameters: f64,
+    },
     #[error("the recording has no t{index} snapshot")]
     MissingSnapshot { index: u32 },
     /// The pairing sidecar could not be written.
@@ -78,6 +88,7 @@ impl Classify for ExtrapolateError {
             | ExtrapolateError::RecordedPeriods { .. }
             | ExtrapolateError::JumpTarget { .. }
             | ExtrapolateError::NoMirrorImage { .. }
+            | ExtrapolateError::CapZoneWithoutCaps { .. }
             | ExtrapolateError::NoDrumAxis { .. } => Fault::Input,
             // a missing snapshot has always exited with 1 (kept so: behaviour unchanged)
             ExtrapolateError::MissingSnapshot { .. }

@@ -256,6 +256,16 @@ pub struct ExtrapolateArgs {
         value_parser = positive("give a length in particle diameters > 0")
     )]
     pub boundary_bin: Option<f64>,
+    /// With `--boundary fresh-drift`: keep the drift within this many particle diameters of
+    /// an end cap (the caps' own circulation, which the DEM repeats every period) and move
+    /// only the middle's, among the middle's bins [default: 0, every bin's is moved]. For a
+    /// drum short for its radius (docs/method.md §6, "The drift at the end caps").
+    #[arg(
+        long = "boundary-cap-zone",
+        value_name = "DIAMETERS",
+        value_parser = non_negative("give a distance in particle diameters ≥ 0")
+    )]
+    pub boundary_cap_zone: Option<f64>,
     /// Print the summary as one JSON object on stdout.
     #[arg(long)]
     pub json: bool,

@@ -457,7 +457,9 @@ impl ExtrapolatePlan {
 
 /// The boundary maps of `kind` with their default pool, cells and bins.
 fn default_maps(kind: BoundaryKind) -> BoundaryMaps {
-    use extrapolate::boundary::{DEFAULT_BIN_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL};
+    use extrapolate::boundary::{
+        DEFAULT_BIN_DIAMETERS, DEFAULT_CAP_ZONE_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL,
+    };
     match kind {
         BoundaryKind::Exact => BoundaryMaps::Exact,
         BoundaryKind::FreshSteps => BoundaryMaps::FreshSteps {
@@ -468,12 +470,14 @@ fn default_maps(kind: BoundaryKind) -> BoundaryMaps {
             pool: DEFAULT_POOL,
             bin_diameters: DEFAULT_BIN_DIAMETERS,
             cell_diameters: DEFAULT_CELL_DIAMETERS,
+            cap_zone_diameters: DEFAULT_CAP_ZONE_DIAMETERS,
         },
     }
 }
 
-/// `--boundary` with `--boundary-pool`, `--boundary-cell` and `--boundary-bin`, which only
-/// the fresh maps take (and the bin only the drift).
+/// `--boundary` with `--boundary-pool`, `--boundary-cell`, `--boundary-bin` and
+/// `--boundary-cap-zone`, which only the fresh maps take (and the bin and cap zone only the
+/// drift).
 fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
     let refused = |message: &str| Err(usage(message.into()));
     Ok(match default_maps(args.boundary) {
@@ -481,11 +485,12 @@ fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
             if args.boundary_pool.is_some()
                 || args.boundary_cell.is_some()
                 || args.boundary_bin.is_some()
+                || args.boundary_cap_zone.is_some()
             {
                 return refused(
-                    "--boundary-pool, --boundary-cell and --boundary-bin set the fresh \
-                     boundary maps; with --boundary exact there is one pairing per start (add \
-                     --boundary fresh-steps or fresh-drift)",
+                    "--boundary-pool, --boundary-cell, --boundary-bin and --boundary-cap-zone \
+                     set the fresh boundary maps; with --boundary exact there is one pairing \
+                     per start (add --boundary fresh-steps or fresh-drift)",
                 );
             }
             BoundaryMaps::Exact
@@ -494,10 +499,10 @@ fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
             pool,
             cell_diameters,
         } => {
-            if args.boundary_bin.is_some() {
+            if args.boundary_bin.is_some() || args.boundary_cap_zone.is_some() {
                 return refused(
-                    "--boundary-bin sets the bins of --boundary fresh-drift; fresh-steps \
-                     redraws each particle's step and has no bins",
+                    "--boundary-bin and --boundary-cap-zone set the drift of --boundary \
+                     fresh-drift; fresh-steps redraws each particle's step and has no drift",
                 );
             }
             BoundaryMaps::FreshSteps {
@@ -509,10 +514,12 @@ fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
             pool,
             bin_diameters,
             cell_diameters,
+            cap_zone_diameters,
         } => BoundaryMaps::FreshDrift {
             pool: args.boundary_pool.unwrap_or(pool),
             bin_diameters: args.boundary_bin.unwrap_or(bin_diameters),
             cell_diameters: args.boundary_cell.unwrap_or(cell_diameters),
+            cap_zone_diameters: args.boundary_cap_zone.unwrap_or(cap_zone_diameters),
         },
     })
 }

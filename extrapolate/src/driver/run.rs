@@ -111,6 +111,17 @@ impl<'a> Extrapolation<'a> {
                 recording: request.recording.clone(),
             });
         }
+        if let BoundaryMaps::FreshDrift {
+            cap_zone_diameters, ..
+        } = request.boundary
+        {
+            if cap_zone_diameters > 0.0 && axial_period(&info).is_some() {
+                return Err(ExtrapolateError::CapZoneWithoutCaps {
+                    recording: request.recording.clone(),
+                    cap_zone_diameters,
+                });
+            }
+        }
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
         let targets = jump_targets(request, used)?;
         let steps: Vec<Step> =

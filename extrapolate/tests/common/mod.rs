@@ -22,6 +22,7 @@ pub fn fresh_maps(pool: u32, bin_diameters: f64) -> [BoundaryMaps; 2] {
             pool,
             bin_diameters,
             cell_diameters: 3.0,
+            cap_zone_diameters: 0.0,
         },
     ]
 }

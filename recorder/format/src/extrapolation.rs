@@ -141,13 +141,22 @@ pub enum Boundary {
     },
     /// A pool of `pool` pairings per start, one drawn at each jump from `seed`, in each of
     /// which the period's coarse axial drift (bins of `bin_diameters` along the axis, cells of
-    /// `cell_diameters` across) is moved along the axis by a random offset.
+    /// `cell_diameters` across) is moved along the axis by a random offset; the drift of the
+    /// bins within `cap_zone_diameters` of an end cap is kept (0, and absent from files
+    /// written without it: every bin's is moved).
     FreshDrift {
         pool: u32,
         bin_diameters: f64,
         cell_diameters: f64,
+        #[serde(default, skip_serializing_if = "is_zero")]
+        cap_zone_diameters: f64,
         seed: u64,
     },
+}
+
+/// A cap zone of none is left out of the file, as files written before it have it.
+fn is_zero(diameters: &f64) -> bool {
+    *diameters == 0.0
 }
 
 impl Boundary {
