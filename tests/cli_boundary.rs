@@ -10,12 +10,18 @@ use std::path::{Path, PathBuf};
 /// The tiny drum heated by its mantle, recorded with τ = 0.2 s (a tenth of a revolution) and
 /// `periods` recorded periods, reproducibly.
 fn heated_recording(dir: &Path, periods: &str) -> PathBuf {
-    let case = dir.join("tiny.toml");
     let heated = TINY_CASE.replace(
         "rotation_period = 2.0",
         "rotation_period = 2.0\nwall_temperature = 350.0",
     );
-    std::fs::write(&case, heated).unwrap();
+    recording(dir, &heated, periods)
+}
+
+/// The case `case_text` recorded in `dir` with τ = 0.2 s and `periods` recorded periods,
+/// reproducibly.
+fn recording(dir: &Path, case_text: &str, periods: &str) -> PathBuf {
+    let case = dir.join("tiny.toml");
+    std::fs::write(&case, case_text).unwrap();
     let run = dir.join("run.mcap");
     tdex_ok(&[
         "record",
@@ -86,18 +92,7 @@ fn fresh_maps_conserve_the_heat_over_500_periods_and_are_a_function_of_the_seed(
     // same drum without the heated mantle, Σ C T after 500 periods of fresh maps is the one
     // at t1
     let adiabatic_dir = tempfile::tempdir().unwrap();
-    let case = adiabatic_dir.path().join("tiny.toml");
-    std::fs::write(&case, TINY_CASE).unwrap();
-    let adiabatic = adiabatic_dir.path().join("run.mcap");
-    tdex_ok(&[
-        "record",
-        case.to_str().unwrap(),
-        "-o",
-        adiabatic.to_str().unwrap(),
-        "--tau",
-        "0.2",
-        "--reproducible",
-    ]);
+    let adiabatic = recording(adiabatic_dir.path(), TINY_CASE, "1");
     for kind in ["fresh-steps", "fresh-drift"] {
         let mut files = Vec::new();
         for threads in ["1", "2"] {
@@ -346,22 +341,11 @@ fn a_path_through_two_recorded_periods_draws_fresh_maps_into_each_start() {
 #[test]
 fn a_cap_zone_is_refused_in_a_section_without_caps() {
     let dir = tempfile::tempdir().unwrap();
-    let case = dir.path().join("section.toml");
     let section = TINY_CASE.replace(
         "rotation_period = 2.0",
         "rotation_period = 2.0\nend_caps = \"periodic\"",
     );
-    std::fs::write(&case, section).unwrap();
-    let run = dir.path().join("section.mcap");
-    tdex_ok(&[
-        "record",
-        case.to_str().unwrap(),
-        "-o",
-        run.to_str().unwrap(),
-        "--tau",
-        "0.2",
-        "--reproducible",
-    ]);
+    let run = recording(dir.path(), &section, "1");
     let out_path = dir.path().join("zoned.mcap");
     let flags = ["--periods", "3", "--boundary", "fresh-drift"];
     let out = run_tdex(&extrapolate_args(
@@ -372,7 +356,7 @@ fn a_cap_zone_is_refused_in_a_section_without_caps() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("section.mcap: its section is periodic along the axis and has no end caps")
+        err.contains("run.mcap: its section is periodic along the axis and has no end caps")
             && err.contains("a cap zone of 2 diameters keeps nothing"),
         "{err}"
     );
