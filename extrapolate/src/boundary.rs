@@ -20,6 +20,9 @@
 //!   coarse axial drift (the mean step of each bin of the axis in each cell of the
 //!   cross-section, beyond the cell's mean over the axis) by a random offset along the axis:
 //!   the drift the exact map repeats becomes a random walk, and neighbours stay neighbours.
+//!   A cap zone keeps the drift near the end caps, where the caps' own circulation drives
+//!   much the same drift every period, and moves only the middle's (for a drum short for its
+//!   radius; docs/method.md, "The drift at the end caps").
 //!
 //! Between end caps a redrawn step stops at the bed's extent; in a section periodic along
 //! its axis ([`AxialEnds::Periodic`]) steps are taken across the seam to the nearest image
