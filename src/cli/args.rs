@@ -674,8 +674,8 @@ pub struct HorizonStudyArgs {
     #[arg(long)]
     pub mirror: bool,
     /// The boundary maps every P runs with, comma-separated (`tdex extrapolate --boundary`,
-    /// with its default pool, cells and bins): e.g. `exact,fresh-steps,fresh-drift` puts
-    /// the three side by side on this case.
+    /// with its default pool, cells and bins, no cap zone): e.g.
+    /// `exact,fresh-steps,fresh-drift` puts the three side by side on this case.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "exact")]
     pub boundary: Vec<BoundaryKind>,
 }
