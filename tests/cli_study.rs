@@ -504,12 +504,59 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     let md = std::fs::read_to_string(fresh.join("study.md")).unwrap();
     assert!(md.contains("P = 2, fresh steps"), "{md}");
 
+    // the fresh maps' settings reach every fresh map of the study, and the exact one ignores
+    // them: its figures are the study's without them
+    let set = dir.path().join("set");
+    let study5 = horizon_from_recording(
+        &rec,
+        &[
+            "--boundary",
+            "exact,fresh-drift",
+            "--boundary-pool",
+            "4",
+            "--boundary-cap-zone",
+            "1",
+        ],
+        &set,
+    );
+    let runs5 = study5["runs"].as_array().unwrap();
+    assert_eq!(runs5[0]["median_ratio"], runs[0]["median_ratio"]);
+    let drift = tdex_format::ExtrapolationReader::open(Path::new(
+        runs5[1]["extrapolation"].as_str().unwrap(),
+    ))
+    .unwrap()
+    .info()
+    .boundary;
+    match drift {
+        tdex_format::extrapolation::Boundary::FreshDrift {
+            pool,
+            cap_zone_diameters,
+            ..
+        } => assert_eq!((pool, cap_zone_diameters), (4, 1.0)),
+        other => panic!("{other:?}"),
+    }
+
     // a recording has its own reference periods; it cannot replay more periods than it holds
     for (flags, expect) in [
         (vec!["--reference", "5"], "--reference: "),
         (
             vec!["--recorded-periods", "3"],
             "holds 2 recorded period(s)",
+        ),
+        (
+            vec!["--recorded-periods", "1", "--boundary-pool", "4"],
+            "with --boundary exact there is one pairing per start",
+        ),
+        (
+            vec![
+                "--recorded-periods",
+                "1",
+                "--boundary",
+                "exact,fresh-steps",
+                "--boundary-bin",
+                "2",
+            ],
+            "--boundary-bin and --boundary-cap-zone set the drift of --boundary fresh-drift",
         ),
     ] {
         let mut args = vec!["study", "horizon", rec.to_str().unwrap()];

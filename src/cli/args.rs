@@ -236,9 +236,20 @@ pub struct ExtrapolateArgs {
     /// period's coarse axial drift along the axis (for heat that varies along the axis).
     #[arg(long, value_enum, default_value_t = BoundaryKind::Exact)]
     pub boundary: BoundaryKind,
+    #[command(flatten)]
+    pub fresh: FreshMapOptions,
+    /// Print the summary as one JSON object on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The fresh boundary maps' settings (`tdex extrapolate`, `tdex study horizon`): each applies
+/// to the maps that have it, and is refused where none of the asked maps does.
+#[derive(Debug, Clone, Default, clap::Args)]
+pub struct FreshMapOptions {
     /// With a fresh boundary: pairings in each start's pool [default: 32].
     #[arg(long = "boundary-pool", value_name = "N", value_parser = pool())]
-    pub boundary_pool: Option<u32>,
+    pub pool: Option<u32>,
     /// With a fresh boundary: width of the cells of the cross-section whose particles' axial
     /// steps (`fresh-steps`) or drift (`fresh-drift`) are taken together, in particle
     /// diameters [default: 3].
@@ -247,7 +258,7 @@ pub struct ExtrapolateArgs {
         value_name = "DIAMETERS",
         value_parser = positive("give a width in particle diameters > 0")
     )]
-    pub boundary_cell: Option<f64>,
+    pub cell: Option<f64>,
     /// With `--boundary fresh-drift`: length of the axial bins of the drift, in particle
     /// diameters [default: 2].
     #[arg(
@@ -255,7 +266,7 @@ pub struct ExtrapolateArgs {
         value_name = "DIAMETERS",
         value_parser = positive("give a length in particle diameters > 0")
     )]
-    pub boundary_bin: Option<f64>,
+    pub bin: Option<f64>,
     /// With `--boundary fresh-drift`: keep the drift within this many particle diameters of
     /// an end cap (the caps' own circulation, which the DEM repeats every period) and move
     /// only the middle's, among the middle's bins [default: 0, every bin's is moved]. For a
@@ -265,10 +276,7 @@ pub struct ExtrapolateArgs {
         value_name = "DIAMETERS",
         value_parser = non_negative("give a distance in particle diameters ≥ 0")
     )]
-    pub boundary_cap_zone: Option<f64>,
-    /// Print the summary as one JSON object on stdout.
-    #[arg(long)]
-    pub json: bool,
+    pub cap_zone: Option<f64>,
 }
 
 /// `tdex extrapolate --boundary`.
@@ -674,10 +682,12 @@ pub struct HorizonStudyArgs {
     #[arg(long)]
     pub mirror: bool,
     /// The boundary maps every P runs with, comma-separated (`tdex extrapolate --boundary`,
-    /// with its default pool, cells and bins, no cap zone): e.g.
-    /// `exact,fresh-steps,fresh-drift` puts the three side by side on this case.
+    /// with the settings below): e.g. `exact,fresh-steps,fresh-drift` puts the three side by
+    /// side on this case.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "exact")]
     pub boundary: Vec<BoundaryKind>,
+    #[command(flatten)]
+    pub fresh: FreshMapOptions,
 }
 
 /// `tdex study regimes`.

@@ -3,9 +3,9 @@
 
 use super::args::{
     BenchArgs, BenchCommand, BenchRecordArgs, BoundaryKind, Cli, Command, CompareArgs, DemoArgs,
-    ExportCommand, ExtrapolateArgs, HorizonStudyArgs, ImportCommand, InspectArgs, LiggghtsArgs,
-    PairArgs, PeriodStudyArgs, RecordArgs, RecordingFlags, RegimesStudyArgs, ReportArgs, RunArgs,
-    SamplingFlags, SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
+    ExportCommand, ExtrapolateArgs, FreshMapOptions, HorizonStudyArgs, ImportCommand, InspectArgs,
+    LiggghtsArgs, PairArgs, PeriodStudyArgs, RecordArgs, RecordingFlags, RegimesStudyArgs,
+    ReportArgs, RunArgs, SamplingFlags, SamplingStudyArgs, StudyCommand, StudyCommon, VtkArgs,
 };
 use anyhow::Result;
 use extrapolate::boundary::BoundaryMaps;
@@ -431,7 +431,8 @@ impl PairPlan {
 impl ExtrapolatePlan {
     fn from_args(args: ExtrapolateArgs) -> Result<Self> {
         check_output(&args.output)?;
-        let boundary = boundary_maps(&args)?;
+        check_fresh_options(&[args.boundary], &args.fresh)?;
+        let boundary = boundary_maps(args.boundary, &args.fresh);
         Ok(ExtrapolatePlan {
             file: args.file,
             periods: args.periods,
@@ -455,73 +456,55 @@ impl ExtrapolatePlan {
     }
 }
 
-/// The boundary maps of `kind` with their default pool, cells and bins.
-fn default_maps(kind: BoundaryKind) -> BoundaryMaps {
+/// The boundary maps of `kind` with the fresh maps' `options` where given, their defaults
+/// elsewhere.
+fn boundary_maps(kind: BoundaryKind, options: &FreshMapOptions) -> BoundaryMaps {
     use extrapolate::boundary::{
         DEFAULT_BIN_DIAMETERS, DEFAULT_CAP_ZONE_DIAMETERS, DEFAULT_CELL_DIAMETERS, DEFAULT_POOL,
     };
+    let pool = options.pool.unwrap_or(DEFAULT_POOL);
+    let cell_diameters = options.cell.unwrap_or(DEFAULT_CELL_DIAMETERS);
     match kind {
         BoundaryKind::Exact => BoundaryMaps::Exact,
         BoundaryKind::FreshSteps => BoundaryMaps::FreshSteps {
-            pool: DEFAULT_POOL,
-            cell_diameters: DEFAULT_CELL_DIAMETERS,
+            pool,
+            cell_diameters,
         },
         BoundaryKind::FreshDrift => BoundaryMaps::FreshDrift {
-            pool: DEFAULT_POOL,
-            bin_diameters: DEFAULT_BIN_DIAMETERS,
-            cell_diameters: DEFAULT_CELL_DIAMETERS,
-            cap_zone_diameters: DEFAULT_CAP_ZONE_DIAMETERS,
+            pool,
+            bin_diameters: options.bin.unwrap_or(DEFAULT_BIN_DIAMETERS),
+            cell_diameters,
+            cap_zone_diameters: options.cap_zone.unwrap_or(DEFAULT_CAP_ZONE_DIAMETERS),
         },
     }
 }
 
-/// `--boundary` with `--boundary-pool`, `--boundary-cell`, `--boundary-bin` and
-/// `--boundary-cap-zone`, which only the fresh maps take (and the bin and cap zone only the
-/// drift).
-fn boundary_maps(args: &ExtrapolateArgs) -> Result<BoundaryMaps> {
-    let refused = |message: &str| Err(usage(message.into()));
-    Ok(match default_maps(args.boundary) {
-        BoundaryMaps::Exact => {
-            if args.boundary_pool.is_some()
-                || args.boundary_cell.is_some()
-                || args.boundary_bin.is_some()
-                || args.boundary_cap_zone.is_some()
-            {
-                return refused(
-                    "--boundary-pool, --boundary-cell, --boundary-bin and --boundary-cap-zone \
-                     set the fresh boundary maps; with --boundary exact there is one pairing \
-                     per start (add --boundary fresh-steps or fresh-drift)",
-                );
-            }
-            BoundaryMaps::Exact
-        }
-        BoundaryMaps::FreshSteps {
-            pool,
-            cell_diameters,
-        } => {
-            if args.boundary_bin.is_some() || args.boundary_cap_zone.is_some() {
-                return refused(
-                    "--boundary-bin and --boundary-cap-zone set the drift of --boundary \
-                     fresh-drift; fresh-steps redraws each particle's step and has no drift",
-                );
-            }
-            BoundaryMaps::FreshSteps {
-                pool: args.boundary_pool.unwrap_or(pool),
-                cell_diameters: args.boundary_cell.unwrap_or(cell_diameters),
-            }
-        }
-        BoundaryMaps::FreshDrift {
-            pool,
-            bin_diameters,
-            cell_diameters,
-            cap_zone_diameters,
-        } => BoundaryMaps::FreshDrift {
-            pool: args.boundary_pool.unwrap_or(pool),
-            bin_diameters: args.boundary_bin.unwrap_or(bin_diameters),
-            cell_diameters: args.boundary_cell.unwrap_or(cell_diameters),
-            cap_zone_diameters: args.boundary_cap_zone.unwrap_or(cap_zone_diameters),
-        },
-    })
+/// `--boundary-pool` and `--boundary-cell` set the fresh maps, `--boundary-bin` and
+/// `--boundary-cap-zone` the drift: each is refused unless one of the `kinds` asked for has
+/// it, so that no setting is silently ignored.
+fn check_fresh_options(kinds: &[BoundaryKind], options: &FreshMapOptions) -> Result<()> {
+    let fresh = kinds.iter().any(|&k| k != BoundaryKind::Exact);
+    let drift = kinds.contains(&BoundaryKind::FreshDrift);
+    let any_given = options.pool.is_some()
+        || options.cell.is_some()
+        || options.bin.is_some()
+        || options.cap_zone.is_some();
+    if any_given && !fresh {
+        return Err(usage(
+            "--boundary-pool, --boundary-cell, --boundary-bin and --boundary-cap-zone set the \
+             fresh boundary maps; with --boundary exact there is one pairing per start (add \
+             --boundary fresh-steps or fresh-drift)"
+                .into(),
+        ));
+    }
+    if (options.bin.is_some() || options.cap_zone.is_some()) && !drift {
+        return Err(usage(
+            "--boundary-bin and --boundary-cap-zone set the drift of --boundary fresh-drift; \
+             fresh-steps redraws each particle's step and has no drift"
+                .into(),
+        ));
+    }
+    Ok(())
 }
 
 impl ComparePlan {
@@ -998,6 +981,7 @@ impl StudyKind {
             seed,
             mirror,
             boundary,
+            fresh,
         } = args;
         let mut recorded_periods = distinct(recorded_periods);
         recorded_periods.sort_unstable();
@@ -1058,9 +1042,10 @@ impl StudyKind {
         } else {
             vec![Symmetry::None]
         };
+        check_fresh_options(&boundary, &fresh)?;
         let mut boundaries: Vec<BoundaryMaps> = Vec::new();
         for &kind in &boundary {
-            let maps = default_maps(kind);
+            let maps = boundary_maps(kind, &fresh);
             if !boundaries.contains(&maps) {
                 boundaries.push(maps);
             }
