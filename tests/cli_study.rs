@@ -341,11 +341,12 @@ fn horizon_from_recording(rec: &Path, flags: &[&str], out: &Path) -> serde_json:
 /// P replayed over the same reference periods and judged against the same DEM runs; the
 /// recording cost grows with P; the same study from the recording itself gives the same
 /// verdicts; flags that shape a recording are refused with a recording.
-#[test]
-fn horizon_study_compares_recorded_periods_on_one_dem_run() {
-    let dir = tempfile::tempdir().unwrap();
-    let case = write_case(dir.path());
-    let out = dir.path().join("horizon");
+/// `tdex study horizon` on the tiny drum in `dir`: two recorded periods and a twin, three
+/// reference periods of a twentieth of a revolution; its JSON and its directory (the
+/// recording is `horizon.mcap` in it).
+fn tiny_horizon_study(dir: &Path) -> (String, PathBuf) {
+    let case = write_case(dir);
+    let out = dir.join("horizon");
     let json = ok(&[
         "study",
         "horizon",
@@ -364,6 +365,13 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
         "-o",
         out.to_str().unwrap(),
     ]);
+    (json, out)
+}
+
+#[test]
+fn horizon_study_compares_recorded_periods_on_one_dem_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let (json, out) = tiny_horizon_study(dir.path());
     let study: serde_json::Value = serde_json::from_str(&json).unwrap();
     let runs = study["runs"].as_array().unwrap();
     let p: Vec<u64> = runs
@@ -441,101 +449,6 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
     let md = std::fs::read_to_string(mirrored.join("study.md")).unwrap();
     assert!(md.contains("P = 2, mirror: mirror check t"), "{md}");
 
-    // with --boundary every P runs with each boundary, the exact one as without the flag,
-    // each fresh one with its own file, the same as `tdex extrapolate --boundary` makes
-    let fresh = dir.path().join("fresh");
-    let study4 = horizon_from_recording(
-        &rec,
-        &["--boundary", "exact,fresh-steps,fresh-drift"],
-        &fresh,
-    );
-    let runs4 = study4["runs"].as_array().unwrap();
-    let shape: Vec<(u64, Option<&str>)> = runs4
-        .iter()
-        .map(|r| {
-            (
-                r["recorded_periods"].as_u64().unwrap(),
-                r.get("boundary").map(|b| b.as_str().unwrap()),
-            )
-        })
-        .collect();
-    assert_eq!(
-        shape,
-        [
-            (1, None),
-            (1, Some("fresh_steps")),
-            (1, Some("fresh_drift")),
-            (2, None),
-            (2, Some("fresh_steps")),
-            (2, Some("fresh_drift"))
-        ]
-    );
-    for (plain, again) in runs.iter().zip([&runs4[0], &runs4[3]]) {
-        assert_eq!(plain["median_ratio"], again["median_ratio"]);
-    }
-    let steps = fresh.join("by_hand.mcap");
-    ok(&[
-        "extrapolate",
-        rec.to_str().unwrap(),
-        "--recorded-periods",
-        "2",
-        "--periods",
-        &study4["reference_periods"].to_string(),
-        "--boundary",
-        "fresh-steps",
-        "-o",
-        steps.to_str().unwrap(),
-    ]);
-    let studied = runs4[4]["extrapolation"].as_str().unwrap();
-    assert!(
-        studied.ends_with("horizon_p2_fresh-steps.extra.mcap"),
-        "{studied}"
-    );
-    let snapshots = |path: &Path| {
-        tdex_format::ExtrapolationReader::open(path)
-            .unwrap()
-            .snapshots()
-            .unwrap()
-            .into_iter()
-            .map(|s| s.temp)
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(snapshots(&steps), snapshots(Path::new(studied)));
-    let md = std::fs::read_to_string(fresh.join("study.md")).unwrap();
-    assert!(md.contains("P = 2, fresh steps"), "{md}");
-
-    // the fresh maps' settings reach every fresh map of the study, and the exact one ignores
-    // them: its figures are the study's without them
-    let set = dir.path().join("set");
-    let study5 = horizon_from_recording(
-        &rec,
-        &[
-            "--boundary",
-            "exact,fresh-drift",
-            "--boundary-pool",
-            "4",
-            "--boundary-cap-zone",
-            "1",
-        ],
-        &set,
-    );
-    let runs5 = study5["runs"].as_array().unwrap();
-    assert_eq!(runs5[0]["median_ratio"], runs[0]["median_ratio"]);
-    let drift = tdex_format::ExtrapolationReader::open(Path::new(
-        runs5[1]["extrapolation"].as_str().unwrap(),
-    ))
-    .unwrap()
-    .info()
-    .boundary;
-    match drift {
-        tdex_format::extrapolation::Boundary::FreshDrift {
-            pool,
-            cap_zone_diameters,
-            ..
-        } => assert_eq!((pool, cap_zone_diameters), (4, 1.0)),
-        other => panic!("{other:?}"),
-    }
-
     // a recording has its own reference periods; it cannot replay more periods than it holds
     for (flags, expect) in [
         (vec!["--reference", "5"], "--reference: "),
@@ -566,5 +479,109 @@ fn horizon_study_compares_recorded_periods_on_one_dem_run() {
         assert_eq!(o.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(err.contains(expect), "{err}");
+    }
+}
+
+/// The horizon study with `--boundary`: every P runs with each boundary map, the exact one as
+/// without the flag, each fresh one with its own file, the same as `tdex extrapolate
+/// --boundary` makes, and with the fresh maps' settings where given.
+#[test]
+fn horizon_study_runs_every_p_with_each_boundary_and_its_settings() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, out) = tiny_horizon_study(dir.path());
+    let rec = out.join("horizon.mcap");
+    let plain = horizon_from_recording(&rec, &[], &dir.path().join("plain"));
+    let runs = plain["runs"].as_array().unwrap();
+    let fresh = dir.path().join("fresh");
+    let by_boundary = horizon_from_recording(
+        &rec,
+        &["--boundary", "exact,fresh-steps,fresh-drift"],
+        &fresh,
+    );
+    let boundary_runs = by_boundary["runs"].as_array().unwrap();
+    let shape: Vec<(u64, Option<&str>)> = boundary_runs
+        .iter()
+        .map(|r| {
+            (
+                r["recorded_periods"].as_u64().unwrap(),
+                r.get("boundary").map(|b| b.as_str().unwrap()),
+            )
+        })
+        .collect();
+    assert_eq!(
+        shape,
+        [
+            (1, None),
+            (1, Some("fresh_steps")),
+            (1, Some("fresh_drift")),
+            (2, None),
+            (2, Some("fresh_steps")),
+            (2, Some("fresh_drift"))
+        ]
+    );
+    for (plain, again) in runs.iter().zip([&boundary_runs[0], &boundary_runs[3]]) {
+        assert_eq!(plain["median_ratio"], again["median_ratio"]);
+    }
+    let steps = fresh.join("by_hand.mcap");
+    ok(&[
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "2",
+        "--periods",
+        &by_boundary["reference_periods"].to_string(),
+        "--boundary",
+        "fresh-steps",
+        "-o",
+        steps.to_str().unwrap(),
+    ]);
+    let studied = boundary_runs[4]["extrapolation"].as_str().unwrap();
+    assert!(
+        studied.ends_with("horizon_p2_fresh-steps.extra.mcap"),
+        "{studied}"
+    );
+    let snapshots = |path: &Path| {
+        tdex_format::ExtrapolationReader::open(path)
+            .unwrap()
+            .snapshots()
+            .unwrap()
+            .into_iter()
+            .map(|s| s.temp)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(snapshots(&steps), snapshots(Path::new(studied)));
+    let md = std::fs::read_to_string(fresh.join("study.md")).unwrap();
+    assert!(md.contains("P = 2, fresh steps"), "{md}");
+
+    // the fresh maps' settings reach every fresh map of the study, and the exact one ignores
+    // them: its figures are the study's without them
+    let set = dir.path().join("set");
+    let with_settings = horizon_from_recording(
+        &rec,
+        &[
+            "--boundary",
+            "exact,fresh-drift",
+            "--boundary-pool",
+            "4",
+            "--boundary-cap-zone",
+            "1",
+        ],
+        &set,
+    );
+    let settings_runs = with_settings["runs"].as_array().unwrap();
+    assert_eq!(settings_runs[0]["median_ratio"], runs[0]["median_ratio"]);
+    let drift = tdex_format::ExtrapolationReader::open(Path::new(
+        settings_runs[1]["extrapolation"].as_str().unwrap(),
+    ))
+    .unwrap()
+    .info()
+    .boundary;
+    match drift {
+        tdex_format::extrapolation::Boundary::FreshDrift {
+            pool,
+            cap_zone_diameters,
+            ..
+        } => assert_eq!((pool, cap_zone_diameters), (4, 1.0)),
+        other => panic!("{other:?}"),
     }
 }
