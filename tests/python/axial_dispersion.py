@@ -10,8 +10,9 @@ The axial dispersion over a lag of L periods: the mean square axial displacement
 particles over L periods (less the bed's mean displacement), over L, in diameters squared per
 period, averaged over starts t_2, t_12, t_22, … (where the replay has left the recorded
 stretch). A random walk's is the same at every lag; the DEM's falls with the lag (a
-particle's axial steps in successive periods partly cancel). Prints per bed the recorded
-period's own (t_0 → t_1, the one the replay repeats) beside the DEM reference's periods'
+particle's axial steps in successive periods partly cancel). Prints per bed the first two
+periods' own (t_0 → t_1, the one a replay of one recorded period repeats, and t_1 → t_2, the
+second of two) beside the DEM reference's periods'
 (t_k → t_k+1 after t_1: their mean and standard deviation, how much one period's varies),
 then at lags of 20 and 100 periods the
 DEM's (the mean over the reference and its twins) beside the extrapolation's and their
@@ -60,8 +61,7 @@ def bed(rec_path, extra_path):
     runs = [by_id(dem)] + [by_id(t) for t in twins]
     ks = [k for k in sorted(extra) if k >= 2 and all(k in r for r in runs)]
     diameter = 2.0 * float(np.median(recorded[0]["r"]))
-    step = (recorded[1]["y"] - recorded[0]["y"]) / diameter
-    own = float(np.mean((step - step.mean()) ** 2))
+    own = [window(recorded, k, k + 1, 1, diameter) for k in (0, 1) if k + 1 in recorded]
     reference = by_id(dem)
     periods = [k for k in sorted(reference) if k >= 1 and k + 1 in reference]
     one_period = [window(reference, k, k + 1, 1, diameter) for k in periods]
@@ -77,9 +77,9 @@ def bed(rec_path, extra_path):
 def main(paths):
     if len(paths) % 2 or not paths:
         sys.exit(__doc__)
-    print("axial dispersion, d² per period: the recorded period's; per lag the DEM runs' mean, "
+    print("axial dispersion, d² per period: the first two periods'; per lag the DEM runs' mean, "
           "the extrapolation's, and their ratio")
-    print("bed                          recorded  DEM period     " + "  ".join(
+    print("bed                          t0→t1  t1→t2  DEM period     " + "  ".join(
         f"lag {lag:3d}: DEM   extra  ratio" for lag in LAGS))
     ratios = {lag: [] for lag in LAGS}
     single = {lag: [] for lag in LAGS}
@@ -95,7 +95,8 @@ def main(paths):
                 cells.append(f"     {dem_value:6.3f}  {extra_value:6.3f}  {extra_value / dem_value:5.2f}")
             else:
                 cells.append(f"{'(too few t_k)':>28}")
-        print(f"{rec:<28} {own:8.3f}  {period_mean:5.3f} ± {period_sd:5.3f}  " + "  ".join(cells))
+        firsts = "  ".join(f"{value:5.3f}" for value in own)
+        print(f"{rec:<28} {firsts:<12}  {period_mean:5.3f} ± {period_sd:5.3f}  " + "  ".join(cells))
     for lag in LAGS:
         values = np.array(ratios[lag])
         if len(values) > 1:
