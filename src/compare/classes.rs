@@ -4,6 +4,7 @@
 //! large ones ride outside and meet the wall first), so a bed mean that agrees can hide
 //! classes that heat at the wrong pace.
 
+use super::floor::min_max;
 use super::SecondKind;
 use serde::Serialize;
 use tdex_format::Snapshot;
@@ -158,16 +159,6 @@ pub struct ClassComparison {
     pub mean_within_spread: Vec<Vec<u32>>,
     /// The `judged` t_k where the second field's segregation index lies within theirs.
     pub index_within_spread: Vec<u32>,
-}
-
-/// Min and max of `values`, NaN left out (None when nothing is left).
-pub(crate) fn min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
-    values
-        .filter(|v| !v.is_nan())
-        .fold(None, |acc, v| match acc {
-            None => Some((v, v)),
-            Some((lo, hi)) => Some((f64::min(lo, v), f64::max(hi, v))),
-        })
 }
 
 impl SizeClasses {

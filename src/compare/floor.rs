@@ -227,6 +227,17 @@ pub fn median(values: &[f64]) -> Option<f64> {
     }
 }
 
+/// Min and max of `values`, NaN left out (None when nothing is left): the range of the DEM
+/// runs' figures a verdict sets a figure beside.
+pub fn min_max(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    values
+        .filter(|v| !v.is_nan())
+        .fold(None, |acc, v| match acc {
+            None => Some((v, v)),
+            Some((lo, hi)) => Some((f64::min(lo, v), f64::max(hi, v))),
+        })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

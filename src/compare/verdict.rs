@@ -2,7 +2,7 @@
 //! pass as one more DEM run of the case (median ratio to their spread ≤ 1 and, with three
 //! or more DEM runs, within their own range at every compared `t_k`)?
 
-use super::floor::{median, Departure};
+use super::floor::{median, min_max, Departure};
 use super::{ContrastKind, PeriodComparison};
 use serde::Serialize;
 
@@ -327,7 +327,7 @@ impl Verdict {
         };
         // the pattern beside the field, where a heated wall moves the bed mean
         let pattern = self.pattern.as_ref().map_or(String::new(), |p| {
-            let dem = super::classes::min_max(p.dem_runs_median_ratio.iter().copied()).map_or(
+            let dem = min_max(p.dem_runs_median_ratio.iter().copied()).map_or(
                 String::new(),
                 |(lo, hi)| {
                     format!(
@@ -639,10 +639,9 @@ fn yardstick_words(
     compared: usize,
     outside: usize,
 ) -> String {
-    let runs = runs_medians;
-    match (median_ratio, super::classes::min_max(runs.iter().copied())) {
+    match (median_ratio, min_max(runs_medians.iter().copied())) {
         (Some(m), Some((lo, hi))) => {
-            let above = runs.iter().filter(|&&r| r > m).count();
+            let above = runs_medians.iter().filter(|&&r| r > m).count();
             let n = compared;
             let counts: Vec<usize> = outside_shares
                 .iter()
@@ -666,7 +665,7 @@ fn yardstick_words(
                  {} above the extrapolation's{beyond}",
                 num(lo),
                 num(hi),
-                runs.len()
+                runs_medians.len()
             )
         }
         _ => String::new(),
