@@ -49,6 +49,23 @@ fn extrapolate_args<'a>(run: &'a Path, out: &'a Path, flags: &[&'a str]) -> Vec<
     args
 }
 
+/// Σ C T at t1 and at the end of an extrapolation's summary, in J.
+fn heat_t1_and_end(report: &serde_json::Value) -> (f64, f64) {
+    (
+        report["total_heat_t1"].as_f64().unwrap(),
+        report["total_heat_end"].as_f64().unwrap(),
+    )
+}
+
+/// The summary's Σ C T at the end is the one at t1, to 1e-12 relative.
+fn assert_heat_conserved(report: &serde_json::Value, what: &str) {
+    let (t1, end) = heat_t1_and_end(report);
+    assert!(
+        ((end - t1) / t1).abs() < 1e-12,
+        "{what}: heat {t1} J at t1, {end} J at the end"
+    );
+}
+
 /// `tdex extrapolate RUN -o OUT --reproducible --json` with `flags`: the summary.
 fn extrapolate(run: &Path, out: &Path, flags: &[&str]) -> serde_json::Value {
     let args = extrapolate_args(run, out, &[&["--reproducible", "--json"], flags].concat());
@@ -102,14 +119,7 @@ fn fresh_maps_conserve_the_heat_over_500_periods_and_are_a_function_of_the_seed(
                 &out,
                 &["--periods", "500", "--boundary", kind, "--threads", threads],
             );
-            let (t1, end) = (
-                report["total_heat_t1"].as_f64().unwrap(),
-                report["total_heat_end"].as_f64().unwrap(),
-            );
-            assert!(
-                ((end - t1) / t1).abs() < 1e-12,
-                "{kind}: heat {t1} J at t1, {end} J after 500 periods"
-            );
+            assert_heat_conserved(&report, kind);
             files.push(std::fs::read(&out).unwrap());
         }
         assert!(files[0] == files[1], "{kind} depends on the threads");
@@ -145,14 +155,7 @@ fn fresh_maps_conserve_the_heat_over_500_periods_and_are_a_function_of_the_seed(
         ],
     );
     assert_eq!(zoned["boundary"]["cap_zone_diameters"], 1.0);
-    let (t1, end) = (
-        zoned["total_heat_t1"].as_f64().unwrap(),
-        zoned["total_heat_end"].as_f64().unwrap(),
-    );
-    assert!(
-        ((end - t1) / t1).abs() < 1e-12,
-        "cap zone: {t1} J, then {end} J"
-    );
+    assert_heat_conserved(&zoned, "cap zone");
     // a zone draws other maps than none (the tiny drum is 6 diameters long: a 1-diameter
     // zone keeps the drift of its end bins)
     assert!(
@@ -324,10 +327,7 @@ fn a_path_through_two_recorded_periods_draws_fresh_maps_into_each_start() {
             let starts: Vec<u64> = pools.iter().map(|p| p["start"].as_u64().unwrap()).collect();
             assert_eq!(starts, [0, 1], "a pool into each start the path enters");
             assert!(pools.iter().all(|p| p["end"] == 2));
-            let (t1, end) = (
-                report["total_heat_t1"].as_f64().unwrap(),
-                report["total_heat_end"].as_f64().unwrap(),
-            );
+            let (t1, end) = heat_t1_and_end(&report);
             assert!(end > t1, "the mantle heats the bed: {t1} J, then {end} J");
             files.push(std::fs::read(&out).unwrap());
         }
