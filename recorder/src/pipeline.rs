@@ -168,37 +168,13 @@ pub fn contact_interactions_in_chunks(
         wall_touching,
         ..
     } = neighbors;
-    let layers = layer_start.len().saturating_sub(1);
-    if layers == 0 {
+    if layer_start.len() < 2 {
         // no list yet: no contacts, and no task to start the sums below
         force.fill([0.0; 3]);
         torque.fill([0.0; 3]);
         heat_flow.fill(0.0);
         return ContactCount::default();
     }
-    let spheres = SphereArrays {
-        pos,
-        vel,
-        omega,
-        radius,
-        mass,
-        temp,
-    };
-    let constants = PairConstants {
-        law: &params.particle_particle,
-        heat: &params.conduction,
-        dt: params.dt,
-        uniform_pair: *uniform_pair,
-    };
-    let axial_period = params.axial_period;
-    let wall_contacts = WallContacts {
-        walls,
-        law: &params.particle_wall,
-        heat: &params.conduction,
-        dt: params.dt,
-        offsets: wall_offsets,
-        index: wall_index,
-    };
     // past the cache size, each task prefetches what the next task of its phase on the same
     // thread will read, spread over its own work
     let task_arrays = TaskArrays {
@@ -218,101 +194,37 @@ pub fn contact_interactions_in_chunks(
         touching: ArrayAddress::of(touching),
         histories: ArrayAddress::of(history),
     };
-    let ahead = (task_arrays.bytes() > prefetch_above).then_some(task_arrays);
-    // the task of layer l writes the slots of l and l + 1, the entries of l and the wall
-    // candidates of the layers it finishes (below), from the start of its pieces (which
-    // reach the next task's start; it touches only those)
-    let start = |l: usize| {
-        let slot = layer_start[l] as usize;
-        TaskStart {
-            slot,
-            pair_entry: offsets[slot] as usize,
-            wall_candidate: wall_offsets[slot] as usize,
-        }
+    let tasks = LayerTasks {
+        spheres: SphereArrays {
+            pos,
+            vel,
+            omega,
+            radius,
+            mass,
+            temp,
+        },
+        constants: PairConstants {
+            law: &params.particle_particle,
+            heat: &params.conduction,
+            dt: params.dt,
+            uniform_pair: *uniform_pair,
+        },
+        walls: WallContacts {
+            walls,
+            law: &params.particle_wall,
+            heat: &params.conduction,
+            dt: params.dt,
+            offsets: wall_offsets,
+            index: wall_index,
+        },
+        ahead: (task_arrays.bytes() > prefetch_above).then_some(task_arrays),
+        layer_start,
+        offsets,
+        partners,
+        axial_period: params.axial_period,
     };
-    let layer_task = |l: usize, pieces: TaskPieces| {
-        let TaskPieces {
-            mut sums,
-            pairs:
-                ListPieces {
-                    histories: h,
-                    touching: touch,
-                },
-            walls: wall_pieces,
-        } = pieces;
-        let first_slot = layer_start[l] as usize;
-        let first_entry = offsets[first_slot] as usize;
-        if l.is_multiple_of(2) {
-            // an even task is the first to write its two layers: their sums start from
-            // zero here, where the task is about to use them, not in a pass of their own
-            // over memory
-            let written = layer_start[(l + 2).min(layers)] as usize - first_slot;
-            sums.force[..written].fill([0.0; 3]);
-            sums.torque[..written].fill([0.0; 3]);
-            sums.heat_flow[..written].fill(0.0);
-        }
-        let slots = first_slot..layer_start[l + 1] as usize;
-        let layer_entries = offsets[slots.end] as usize - first_entry;
-        // the layer's histories are packed: those of its touching entries, in entry
-        // order, from its first entry on (the stream the stage reads is the contacts',
-        // not the list's)
-        let touched = touch[..layer_entries]
-            .iter()
-            .map(|&t| usize::from(t))
-            .sum::<usize>();
-        let mut next = match &ahead {
-            Some(arrays) if l + 2 < layers => {
-                let share = touched as f64 / layer_entries.max(1) as f64;
-                arrays.prefetch(l + 2, layer_start, offsets, share)
-            }
-            _ => Prefetch::default(),
-        };
-        let holders = slots.len().max(1) as f64;
-        let pair_entries = OLD_HISTORIES.with_borrow_mut(|old| {
-            old.clear();
-            old.extend_from_slice(&h[..touched]);
-            old.push(ContactHistory::default());
-            let mut batch = PairBatch::default();
-            // the holder's sums are kept apart and added once its contacts are done, as
-            // each pair's partner sums are added in pair order: the order of every sum
-            // is fixed by the list alone
-            let mut holder = Holder::default();
-            let entries = ListEntries {
-                slots,
-                offsets,
-                partners,
-                first_entry,
-                fresh: touched as u32,
-            };
-            let mut evaluate = |batch: &mut PairBatch| {
-                batch.evaluate(&constants, &spheres, old, h);
-                holder.scatter(batch, &mut sums, first_slot);
-                next.advance(holder.slots_done(first_slot) as f64 / holders);
-            };
-            let touching_pairs = narrow_phase::scan(
-                &entries,
-                pos,
-                radius,
-                axial_period,
-                touch,
-                &mut batch,
-                &mut evaluate,
-            );
-            // the batch holds fewer than a full batch's contacts now: one evaluation
-            evaluate(&mut batch);
-            holder.add_to(&mut sums, first_slot);
-            touching_pairs
-        });
-        let finished = finished_slots(l, layer_start);
-        let wall = wall_contacts.add(&spheres, finished, first_slot, &mut sums, wall_pieces);
-        ContactCount {
-            pair_entries: 2 * pair_entries,
-            wall,
-        }
-    };
-    // task k of a phase owns layer l = phase + 2k (its pieces reach the next task's start)
-    let mut run = |phase: usize, tasks: Range<usize>| {
-        let arrays = TaskPieces {
+    let run = |phase: usize, range: Range<usize>| {
+        let pieces = TaskPieces {
             sums: Sums {
                 force: &mut force[..],
                 torque: &mut torque[..],
@@ -327,22 +239,24 @@ pub fn contact_interactions_in_chunks(
                 touching: &mut wall_touching[..],
             },
         };
-        let layer = |k: usize| phase + 2 * k;
-        let work = |k: usize, pieces: TaskPieces| layer_task(layer(k), pieces);
-        for_each_task(
-            arrays,
-            TaskStart::default(),
-            tasks,
-            &|k| start(layer(k)),
-            &work,
-        )
+        tasks.run_phase(phase, range, pieces)
     };
-    // The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a
-    // layer of each, and each particle's sums keep that order). Rather than all even
-    // tasks, then all odd ones, which reads every layer from memory twice once the state
-    // outgrows the cache, the layers go in chunks of about `chunk` particles: a chunk's even
-    // tasks, then the odd tasks whose two even neighbours are done; the chunk's last odd
-    // layer waits for the next chunk's first even one. Same tasks, same order of every sum.
+    in_chunks(layer_start, chunk, run)
+}
+
+/// The odd task of layer l must follow the even tasks of l - 1 and l + 1 (it writes a layer
+/// of each, and each particle's sums keep that order). Rather than all even tasks, then all
+/// odd ones, which reads every layer from memory twice once the state outgrows the cache,
+/// the layers go in chunks of about `chunk` particles: a chunk's even tasks, then the odd
+/// tasks whose two even neighbours are done; the chunk's last odd layer waits for the next
+/// chunk's first even one. Same tasks, same order of every sum. `run(phase, tasks)` runs
+/// the tasks `tasks` of a phase (task k of a phase owns layer `phase + 2k`).
+fn in_chunks(
+    layer_start: &[u32],
+    chunk: u32,
+    mut run: impl FnMut(usize, Range<usize>) -> ContactCount,
+) -> ContactCount {
+    let layers = layer_start.len() - 1;
     let odd_tasks = layers.saturating_sub(1).div_ceil(2);
     let (mut count, mut first, mut odd_done) = (ContactCount::default(), 0, 0);
     while first < layers {
@@ -362,6 +276,139 @@ pub fn contact_interactions_in_chunks(
         first = end;
     }
     count
+}
+
+/// What every pair task of a step reads: the state, the laws, the list's layout, and where
+/// to prefetch the next task's data (when it pays).
+struct LayerTasks<'a> {
+    spheres: SphereArrays<'a>,
+    constants: PairConstants<'a>,
+    walls: WallContacts<'a>,
+    ahead: Option<TaskArrays>,
+    layer_start: &'a [u32],
+    offsets: &'a [u32],
+    partners: &'a [u32],
+    axial_period: Option<AxialPeriod>,
+}
+
+impl LayerTasks<'_> {
+    fn layers(&self) -> usize {
+        self.layer_start.len() - 1
+    }
+
+    /// Runs the tasks `tasks` of a phase (0 even, 1 odd), in parallel, each on its pieces of
+    /// the arrays (task k owns layer `phase + 2k`; its pieces reach the next task's start).
+    fn run_phase(&self, phase: usize, tasks: Range<usize>, pieces: TaskPieces) -> ContactCount {
+        let layer = |k: usize| phase + 2 * k;
+        for_each_task(
+            pieces,
+            TaskStart::default(),
+            tasks,
+            &|k| self.start(layer(k)),
+            &|k, pieces| self.run_layer(layer(k), pieces),
+        )
+    }
+
+    /// Where the pieces of the task of layer `l` start: it writes the slots of `l` and
+    /// `l + 1`, the entries of `l` and the wall candidates of the layers it finishes (below).
+    fn start(&self, l: usize) -> TaskStart {
+        let slot = self.layer_start[l] as usize;
+        TaskStart {
+            slot,
+            pair_entry: self.offsets[slot] as usize,
+            wall_candidate: self.walls.offsets[slot] as usize,
+        }
+    }
+
+    /// The task of layer `l`: its pairs, then the wall contacts of the slots it finishes.
+    fn run_layer(&self, l: usize, pieces: TaskPieces) -> ContactCount {
+        let TaskPieces {
+            mut sums,
+            pairs,
+            walls: wall_pieces,
+        } = pieces;
+        let first_slot = self.layer_start[l] as usize;
+        if l.is_multiple_of(2) {
+            // an even task is the first to write its two layers: their sums start from
+            // zero here, where the task is about to use them, not in a pass of their own
+            // over memory
+            let written = self.layer_start[(l + 2).min(self.layers())] as usize - first_slot;
+            sums.force[..written].fill([0.0; 3]);
+            sums.torque[..written].fill([0.0; 3]);
+            sums.heat_flow[..written].fill(0.0);
+        }
+        let pair_entries = self.pairs(l, &mut sums, pairs);
+        let finished = finished_slots(l, self.layer_start);
+        let wall = self
+            .walls
+            .add(&self.spheres, finished, first_slot, &mut sums, wall_pieces);
+        ContactCount {
+            pair_entries: 2 * pair_entries,
+            wall,
+        }
+    }
+
+    /// The pair contacts of layer `l` added to `sums`; returns the touching pairs.
+    fn pairs(&self, l: usize, sums: &mut Sums, pieces: ListPieces) -> u64 {
+        let ListPieces {
+            histories: h,
+            touching: touch,
+        } = pieces;
+        let first_slot = self.layer_start[l] as usize;
+        let first_entry = self.offsets[first_slot] as usize;
+        let slots = first_slot..self.layer_start[l + 1] as usize;
+        let layer_entries = self.offsets[slots.end] as usize - first_entry;
+        // the layer's histories are packed: those of its touching entries, in entry
+        // order, from its first entry on (the stream the stage reads is the contacts',
+        // not the list's)
+        let touched = touch[..layer_entries]
+            .iter()
+            .map(|&t| usize::from(t))
+            .sum::<usize>();
+        let mut next = match &self.ahead {
+            Some(arrays) if l + 2 < self.layers() => {
+                let share = touched as f64 / layer_entries.max(1) as f64;
+                arrays.prefetch(l + 2, self.layer_start, self.offsets, share)
+            }
+            _ => Prefetch::default(),
+        };
+        let holders = slots.len().max(1) as f64;
+        OLD_HISTORIES.with_borrow_mut(|old| {
+            old.clear();
+            old.extend_from_slice(&h[..touched]);
+            old.push(ContactHistory::default());
+            let mut batch = PairBatch::default();
+            // the holder's sums are kept apart and added once its contacts are done, as
+            // each pair's partner sums are added in pair order: the order of every sum
+            // is fixed by the list alone
+            let mut holder = Holder::default();
+            let entries = ListEntries {
+                slots,
+                offsets: self.offsets,
+                partners: self.partners,
+                first_entry,
+                fresh: touched as u32,
+            };
+            let mut evaluate = |batch: &mut PairBatch| {
+                batch.evaluate(&self.constants, &self.spheres, old, h);
+                holder.scatter(batch, sums, first_slot);
+                next.advance(holder.slots_done(first_slot) as f64 / holders);
+            };
+            let touching_pairs = narrow_phase::scan(
+                &entries,
+                self.spheres.pos,
+                self.spheres.radius,
+                self.axial_period,
+                touch,
+                &mut batch,
+                &mut evaluate,
+            );
+            // the batch holds fewer than a full batch's contacts now: one evaluation
+            evaluate(&mut batch);
+            holder.add_to(sums, first_slot);
+            touching_pairs
+        })
+    }
 }
 
 /// The slots whose pair sums are complete once the task of layer `l` has run, so their wall
