@@ -301,22 +301,136 @@ impl Verdict {
 
     /// The verdict in words, from its figures and its `setting`.
     fn words(&self, setting: &Setting) -> String {
-        let dem_runs = setting.dem_runs;
-        // the yardstick beside the median: how the DEM runs themselves score on it, and how
-        // often each is beyond the others' range
-        let yardstick = yardstick_words(
-            self.median_ratio,
-            &self.dem_runs_median_ratio,
-            &self.dem_runs_outside_share,
-            self.compared.len(),
-            self.outside_range.len(),
-        );
+        // what follows the sentence's head, in every judged verdict: the yardstick beside
+        // the median (how the DEM runs themselves score on it, and how often each is
+        // beyond the others' range), then the recorded span left out, the means, the
+        // pattern and whose distance it is
+        let tail = [
+            yardstick_words(
+                self.median_ratio,
+                &self.dem_runs_median_ratio,
+                &self.dem_runs_outside_share,
+                self.compared.len(),
+                self.outside_range.len(),
+            ),
+            self.left_out_words(),
+            self.means_words(setting),
+            self.pattern_words(),
+            self.runs_note(setting),
+        ]
+        .concat();
+        match (self.passes, self.median_ratio) {
+            (Some(true), Some(m)) => self.passing_words(setting, m, &tail),
+            (Some(false), Some(m)) => self.failing_words(setting, m, &tail),
+            _ => self.unjudged_words(setting),
+        }
+    }
+
+    /// "passes as one more DEM run: …", with the median `m`.
+    fn passing_words(&self, setting: &Setting, m: f64, tail: &str) -> String {
+        let beyond = if self.outside_range.is_empty() {
+            "never beyond the farthest two".to_string()
+        } else {
+            // only with one pair of runs (see `of`): say where, and why it passes
+            format!(
+                "farther from the two DEM runs than they are from each other at {}, as a \
+                 further DEM run would be at about half the t_k (one twin: the median decides)",
+                instants(&self.outside_range, setting.past_recording)
+            )
+        };
+        format!(
+            "passes as one more DEM run: its distance to the DEM runs is {} times theirs to \
+             each other over {} (median {}), {beyond}{tail}",
+            self.range_words(),
+            instants(&self.compared, self.compared.len()),
+            beside_one(m),
+        )
+    }
+
+    /// "does not pass as one more DEM run: …", with the median `m`.
+    fn failing_words(&self, setting: &Setting, m: f64, tail: &str) -> String {
+        let beyond = if self.outside_range.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; farther {} at {}",
+                if setting.dem_runs == 2 {
+                    "from the two DEM runs than they are from each other"
+                } else {
+                    "than the two farthest DEM runs"
+                },
+                instants(&self.outside_range, setting.past_recording)
+            )
+        };
+        // with three runs their range is still narrow: an exchangeable further run falls
+        // outside it at some t_k most of the time, so a narrow miss is read through the
+        // median; a genuine DEM run's median lay within 0.96-1.08 (docs/validation.md),
+        // hence 1.1. (With two runs the median decides.)
+        let few = if setting.dem_runs == 3 && !self.outside_range.is_empty() && m <= 1.1 {
+            format!(
+                " (with only {} DEM runs, a genuine further DEM run also falls outside their \
+                 range at some t_k: read the median ratio)",
+                setting.dem_runs
+            )
+        } else {
+            String::new()
+        };
+        let median = if m > 1.0 {
+            format!("{} > 1", above_one(m))
+        } else {
+            num(m)
+        };
+        format!(
+            "does not pass as one more DEM run: {} times the DEM runs' distance to each other \
+             over {} (median {median}){beyond}{few}{tail}",
+            self.range_words(),
+            instants(&self.compared, self.compared.len()),
+        )
+    }
+
+    /// Why there is no judgement: nothing compared past the recording, no spread, or one
+    /// DEM run.
+    fn unjudged_words(&self, setting: &Setting) -> String {
+        let means = self.means_words(setting);
+        if setting.floors && self.compared.is_empty() && !self.within_recording.is_empty() {
+            format!(
+                "not judged: at every compared t_k ({}) the extrapolation is still the \
+                 recorded run, which it follows until its first jump through a pairing; \
+                 compare t_k past the recorded periods{means}",
+                instants(&self.within_recording, self.within_recording.len())
+            )
+        } else if setting.floors {
+            format!(
+                "the {} DEM runs are identical at every compared t_k (floor 0): there is no \
+                 spread to judge the extrapolation against{means}",
+                setting.dem_runs
+            )
+        } else {
+            format!(
+                "not judged: one DEM run alone is no yardstick, since two runs of a chaotic \
+                 flow part by particle diameters within a period (record with --twins 2 to \
+                 measure the DEM's own spread){means}"
+            )
+        }
+    }
+
+    /// The ratio's range over the compared `t_k` ("0.9–1.03", or the one ratio).
+    fn range_words(&self) -> String {
+        match (self.ratio_min, self.ratio_max) {
+            (Some(lo), Some(hi)) if self.compared.len() > 1 => format!("{}–{}", num(lo), num(hi)),
+            (Some(only), _) => num(only),
+            _ => String::new(),
+        }
+    }
+
+    /// The group (bed) means' largest error, beside the DEM runs' spread.
+    fn means_words(&self, setting: &Setting) -> String {
         let what = if setting.groups {
             "group means"
         } else {
             "bed mean"
         };
-        let means = match (self.means_error_max, self.means_spread_max) {
+        match (self.means_error_max, self.means_spread_max) {
             (Some(e), Some(s)) => format!(
                 "; {what} within {} of the DEM's (the DEM runs differ by up to {})",
                 kelvin(e),
@@ -324,42 +438,44 @@ impl Verdict {
             ),
             (Some(e), None) => format!("; {what} within {} of the DEM's", kelvin(e)),
             _ => String::new(),
+        }
+    }
+
+    /// The pattern beside the field, where a heated wall moves the bed mean.
+    fn pattern_words(&self) -> String {
+        let Some(p) = &self.pattern else {
+            return String::new();
         };
-        // the pattern beside the field, where a heated wall moves the bed mean
-        let pattern = self.pattern.as_ref().map_or(String::new(), |p| {
-            let dem = min_max(p.dem_runs_median_ratio.iter().copied()).map_or(
-                String::new(),
-                |(lo, hi)| {
-                    format!(
-                        ", each DEM run's judged the same way {}–{}",
-                        num(lo),
-                        num(hi)
-                    )
-                },
-            );
-            format!(
-                "; each field less its own bed mean (where the heat is, apart from how fast the \
-                 bed heats): median ratio {}{dem}",
-                beside_one(p.median_ratio)
-            )
-        });
-        let range = match (self.ratio_min, self.ratio_max) {
-            (Some(lo), Some(hi)) if self.compared.len() > 1 => format!("{}–{}", num(lo), num(hi)),
-            (Some(only), _) => num(only),
-            _ => String::new(),
-        };
-        // the recorded span, named so that a reader knows why the verdict starts later
-        let left_out = if self.within_recording.is_empty() {
-            String::new()
-        } else {
-            format!(
-                "; {} left out, where the extrapolation is still the recorded run",
-                instants(&self.within_recording, self.within_recording.len())
-            )
-        };
-        // which runs its distance went to and how fair their spread is, where it is not
-        // simply all of them
-        let runs_note = match setting.departure {
+        let dem =
+            min_max(p.dem_runs_median_ratio.iter().copied()).map_or(String::new(), |(lo, hi)| {
+                format!(
+                    ", each DEM run's judged the same way {}–{}",
+                    num(lo),
+                    num(hi)
+                )
+            });
+        format!(
+            "; each field less its own bed mean (where the heat is, apart from how fast the bed \
+             heats): median ratio {}{dem}",
+            beside_one(p.median_ratio)
+        )
+    }
+
+    /// The recorded span, named so that a reader knows why the verdict starts later.
+    fn left_out_words(&self) -> String {
+        if self.within_recording.is_empty() {
+            return String::new();
+        }
+        format!(
+            "; {} left out, where the extrapolation is still the recorded run",
+            instants(&self.within_recording, self.within_recording.len())
+        )
+    }
+
+    /// Which runs its distance went to and how fair their spread is, where it is not simply
+    /// all of them.
+    fn runs_note(&self, setting: &Setting) -> String {
+        match setting.departure {
             _ if setting.dem_runs < 2 || self.median_ratio.is_none() => String::new(),
             Departure::BeforeTheTwins { left, parted } => {
                 let fair_from = parted + 1;
@@ -375,84 +491,6 @@ impl Verdict {
                 .map_or(String::new(), |runs| {
                     format!("; its distance measured to {runs}")
                 }),
-        };
-        match (self.passes, self.median_ratio) {
-            (Some(true), Some(m)) => format!(
-                "passes as one more DEM run: its distance to the DEM runs is {range} times \
-                 theirs to each other over {} (median {}), {}{yardstick}{left_out}{means}{pattern}\
-                 {runs_note}",
-                instants(&self.compared, self.compared.len()),
-                beside_one(m),
-                if self.outside_range.is_empty() {
-                    "never beyond the farthest two".to_string()
-                } else {
-                    // only with one pair of runs (above): say where, and why it passes
-                    format!(
-                        "farther from the two DEM runs than they are from each other at {}, \
-                         as a further DEM run would be at about half the t_k (one twin: the \
-                         median decides)",
-                        instants(&self.outside_range, setting.past_recording)
-                    )
-                }
-            ),
-            (Some(false), Some(m)) => {
-                let beyond = if self.outside_range.is_empty() {
-                    String::new()
-                } else {
-                    format!(
-                        "; farther {} at {}",
-                        if setting.dem_runs == 2 {
-                            "from the two DEM runs than they are from each other"
-                        } else {
-                            "than the two farthest DEM runs"
-                        },
-                        instants(&self.outside_range, setting.past_recording)
-                    )
-                };
-                // with three runs their range is still narrow: an exchangeable further run
-                // falls outside it at some t_k most of the time, so a narrow miss is read
-                // through the median; a genuine DEM run's median lay within 0.96-1.08
-                // (docs/validation.md), hence 1.1. (With two runs the median decides.)
-                let few = if setting.dem_runs == 3 && !self.outside_range.is_empty() && m <= 1.1 {
-                    format!(
-                        " (with only {dem_runs} DEM runs, a genuine further DEM run also \
-                         falls outside their range at some t_k: read the median ratio)"
-                    )
-                } else {
-                    String::new()
-                };
-                format!(
-                    "does not pass as one more DEM run: {range} times the DEM runs' distance to \
-                     each other over {} (median {}){beyond}{few}{yardstick}{left_out}{means}{pattern}\
-                     {runs_note}",
-                    instants(&self.compared, self.compared.len()),
-                    if m > 1.0 {
-                        format!("{} > 1", above_one(m))
-                    } else {
-                        num(m)
-                    },
-                )
-            }
-            _ if setting.floors
-                && self.compared.is_empty()
-                && !self.within_recording.is_empty() =>
-            {
-                format!(
-                "not judged: at every compared t_k ({}) the extrapolation is still the recorded \
-                 run, which it follows until its first jump through a pairing; compare t_k past \
-                 the recorded periods{means}",
-                instants(&self.within_recording, self.within_recording.len())
-            )
-            }
-            _ if setting.floors => format!(
-                "the {dem_runs} DEM runs are identical at every compared t_k (floor 0): there \
-                 is no spread to judge the extrapolation against{means}"
-            ),
-            _ => format!(
-                "not judged: one DEM run alone is no yardstick, since two runs of a chaotic \
-                 flow part by particle diameters within a period (record with --twins 2 to \
-                 measure the DEM's own spread){means}"
-            ),
         }
     }
 
