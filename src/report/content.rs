@@ -632,6 +632,55 @@ fn prediction_section(d: &mut Document, inp: &Inputs) {
 
 fn errors_section(d: &mut Document, c: &Comparison) {
     d.push(Block::Heading(2, "Errors (Table 5 form)".into()));
+    errors_definitions(d, c);
+    d.push(para(vec![
+        bold("Trust"),
+        text(format!(": {}.", c.verdict.text.trim_end_matches('.'))),
+    ]));
+    // rows that have no value at any t_k are left out, never shown as dashes
+    let quantities: Vec<(&str, Box<Cell>)> = error_rows(c)
+        .into_iter()
+        .filter(|(_, f)| c.periods.iter().any(|p| f(p).is_some()))
+        .collect();
+    for chunk in c.periods.chunks(COLUMNS_PER_TABLE) {
+        let mut header = vec!["Extrapolation step".to_string()];
+        header.extend(chunk.iter().map(|p| format!("t_{}", p.k)));
+        let rows = quantities
+            .iter()
+            .map(|(label, f)| {
+                let mut r = vec![label.to_string()];
+                r.extend(chunk.iter().map(|p| f(p).unwrap_or_else(|| "-".into())));
+                r
+            })
+            .collect();
+        d.push(Block::Table {
+            header,
+            rows,
+            numeric: true,
+        });
+    }
+    if !c.unreferenced.is_empty() {
+        d.push(para(vec![text(format!(
+            "No DEM reference for {} (the recording was made with a smaller --reference): \
+             not compared.",
+            crate::compare::span_of(&c.unreferenced)
+        ))]));
+    }
+    figure(
+        d,
+        "ε_abs with the DEM runs' own spread (the floor, where twins were recorded), ε_rel and \
+         the Eq. 10 error, and the contrast ε_rel divides by, per extrapolation step (a decaying \
+         contrast makes ε_rel grow for the same ε_abs): ",
+        ERRORS_SVG,
+        "Absolute, relative and energy-transfer errors per extrapolation step, and the contrast",
+    );
+}
+
+/// A row of the errors' table: its value at a `t_k`, if it has one there.
+type Cell = dyn Fn(&PeriodComparison) -> Option<String>;
+
+/// What ε_abs, ε_rel, the Eq. 10 error and (with twins) the floor are, for this comparison.
+fn errors_definitions(d: &mut Document, c: &Comparison) {
     let divisor = match c.contrast {
         ContrastKind::HotCold => {
             "|T̄_hot − T̄_cold| with the DEM means of the initially hot and cold particles (Eq. 9)"
@@ -679,14 +728,13 @@ fn errors_section(d: &mut Document, c: &Comparison) {
             )),
         ]));
     }
-    d.push(para(vec![
-        bold("Trust"),
-        text(format!(": {}.", c.verdict.text.trim_end_matches('.'))),
-    ]));
-    type Cell = dyn Fn(&PeriodComparison) -> Option<String>;
+}
+
+/// The errors' table rows, each a label and its value at a `t_k`: the errors, the floor,
+/// the ratio, then the group (or bed) means and the cells used.
+fn error_rows(c: &Comparison) -> Vec<(&'static str, Box<Cell>)> {
     let temp = |x: Option<f64>| x.map(|v| format!("{v:.4}"));
     let pct = |x: Option<f64>| x.map(|v| sig(100.0 * v, 4));
-    // rows that have no value at any t_k are left out, never shown as dashes
     let groups = c.contrast == ContrastKind::HotCold;
     let mut quantities: Vec<(&str, Box<Cell>)> = vec![
         ("t (s)", Box::new(|p| Some(short(p.t)))),
@@ -768,42 +816,7 @@ fn errors_section(d: &mut Document, c: &Comparison) {
         "Voronoi cells used",
         Box::new(|p| Some(p.cells_used.to_string())),
     ));
-    let quantities: Vec<(&str, Box<Cell>)> = quantities
-        .into_iter()
-        .filter(|(_, f)| c.periods.iter().any(|p| f(p).is_some()))
-        .collect();
-    for chunk in c.periods.chunks(COLUMNS_PER_TABLE) {
-        let mut header = vec!["Extrapolation step".to_string()];
-        header.extend(chunk.iter().map(|p| format!("t_{}", p.k)));
-        let rows = quantities
-            .iter()
-            .map(|(label, f)| {
-                let mut r = vec![label.to_string()];
-                r.extend(chunk.iter().map(|p| f(p).unwrap_or_else(|| "-".into())));
-                r
-            })
-            .collect();
-        d.push(Block::Table {
-            header,
-            rows,
-            numeric: true,
-        });
-    }
-    if !c.unreferenced.is_empty() {
-        d.push(para(vec![text(format!(
-            "No DEM reference for {} (the recording was made with a smaller --reference): \
-             not compared.",
-            crate::compare::span_of(&c.unreferenced)
-        ))]));
-    }
-    figure(
-        d,
-        "ε_abs with the DEM runs' own spread (the floor, where twins were recorded), ε_rel and \
-         the Eq. 10 error, and the contrast ε_rel divides by, per extrapolation step (a decaying \
-         contrast makes ε_rel grow for the same ε_abs): ",
-        ERRORS_SVG,
-        "Absolute, relative and energy-transfer errors per extrapolation step, and the contrast",
-    );
+    quantities
 }
 
 /// A bed of several particle sizes: each class's mean temperature and the radial
