@@ -103,6 +103,105 @@ impl BoundaryMaps {
     }
 }
 
+/// The fresh maps asked of one recording, checked against how its axis ends: what each
+/// start's pool redraws (lengths in particle diameters). A cap zone exists only between
+/// end caps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Redraws {
+    Steps {
+        pool: u32,
+        cell_diameters: f64,
+        axis: AxialEnds,
+    },
+    Drift {
+        pool: u32,
+        grid_diameters: DriftGrid,
+        ends: DriftEnds,
+    },
+}
+
+impl Redraws {
+    /// What `maps` redraws in a recording whose axis ends as `axis`: `Ok(None)` for the
+    /// exact map, `Err(cap zone)` for a cap zone in a section periodic along the axis.
+    pub fn of(maps: BoundaryMaps, axis: AxialEnds) -> Result<Option<Self>, f64> {
+        Ok(match maps {
+            BoundaryMaps::Exact => None,
+            BoundaryMaps::FreshSteps {
+                pool,
+                cell_diameters,
+            } => Some(Self::Steps {
+                pool,
+                cell_diameters,
+                axis,
+            }),
+            BoundaryMaps::FreshDrift {
+                pool,
+                bin_diameters,
+                cell_diameters,
+                cap_zone_diameters,
+            } => Some(Self::Drift {
+                pool,
+                grid_diameters: DriftGrid {
+                    bin: bin_diameters,
+                    cell: cell_diameters,
+                },
+                ends: match axis {
+                    AxialEnds::Caps => DriftEnds::Caps {
+                        kept_zone: cap_zone_diameters,
+                    },
+                    AxialEnds::Periodic { length } if cap_zone_diameters == 0.0 => {
+                        DriftEnds::Periodic { length }
+                    }
+                    AxialEnds::Periodic { .. } => return Err(cap_zone_diameters),
+                },
+            }),
+        })
+    }
+}
+
+/// The drift's grid: bins of `bin` along the axis, squares of `cell` across it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriftGrid {
+    pub bin: f64,
+    pub cell: f64,
+}
+
+impl DriftGrid {
+    fn scaled(self, by: f64) -> Self {
+        Self {
+            bin: self.bin * by,
+            cell: self.cell * by,
+        }
+    }
+}
+
+/// How the drift's axis ends: between caps, where the drift of the bins whose centre is
+/// within `kept_zone` of an end of the bed is kept (0: none is), or periodic.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum DriftEnds {
+    Caps { kept_zone: f64 },
+    Periodic { length: f64 },
+}
+
+impl DriftEnds {
+    fn axis(self) -> AxialEnds {
+        match self {
+            Self::Caps { .. } => AxialEnds::Caps,
+            Self::Periodic { length } => AxialEnds::Periodic { length },
+        }
+    }
+
+    /// The ends with the cap zone (a length in diameters) in metres, for diameter `d`.
+    fn scaled(self, d: f64) -> Self {
+        match self {
+            Self::Caps { kept_zone } => Self::Caps {
+                kept_zone: kept_zone * d,
+            },
+            periodic => periodic,
+        }
+    }
+}
+
 /// How the drum's axis ends, which decides what a redrawn axial step does at an end: stop
 /// there (end caps), or cross the seam and come back through the other face (a section
 /// periodic along the axis, [`crate::axial_period`] of the recording).
@@ -225,31 +324,27 @@ pub struct AxialDrift {
 }
 
 impl AxialDrift {
-    /// The drift of the period `start` → `end`; between caps, the drift of the bins whose
-    /// centre is within `cap_zone` of an end of the bed is kept (0: none is).
-    pub fn of(
-        start: &Snapshot,
-        end: &Snapshot,
-        bin: f64,
-        cell: f64,
-        cap_zone: f64,
-        axis: AxialEnds,
-    ) -> Self {
+    /// The drift of the period `start` → `end` on `grid`; between caps, the drift of the
+    /// bins in the cap zone is kept.
+    pub fn of(start: &Snapshot, end: &Snapshot, grid: DriftGrid, ends: DriftEnds) -> Self {
+        let (axis, cell) = (ends.axis(), grid.cell);
         let extent = axis.span(&end.pos);
         let (bin, bins) = match axis {
             AxialEnds::Caps => (
-                bin,
-                (((extent.1 - extent.0) / bin).floor() as usize + 1).max(1),
+                grid.bin,
+                (((extent.1 - extent.0) / grid.bin).floor() as usize + 1).max(1),
             ),
             AxialEnds::Periodic { length } => {
                 // whole bins around the seam, so that moving the drift by some of them is a
                 // translation of the section onto itself
-                let bins = ((length / bin).round() as usize).max(1);
+                let bins = ((length / grid.bin).round() as usize).max(1);
                 (length / bins as f64, bins)
             }
         };
-        let moved = match axis {
-            AxialEnds::Caps if cap_zone > 0.0 => {
+        let moved = match ends {
+            DriftEnds::Caps {
+                kept_zone: cap_zone,
+            } if cap_zone > 0.0 => {
                 let centre = |b: usize| extent.0 + (b as f64 + 0.5) * bin;
                 let first = (0..bins).find(|&b| centre(b) >= extent.0 + cap_zone);
                 let last = (0..bins).rev().find(|&b| centre(b) <= extent.1 - cap_zone);
@@ -359,47 +454,45 @@ pub struct Pool {
     pub summary: FreshPool,
 }
 
-/// The pool of fresh pairings the boundary `maps` asks for (`None` for the exact one), of the
-/// period from `before` (`t_{p−1}`) to `end` (`t_p`) into `start` (the snapshot, or its
-/// image, a jump enters), drawn from `seed`; in a periodic section (`axis`) the pairings
-/// take their distances across the seam, as the exact one does.
+/// The pool of fresh pairings `redraws` asks for, of the period from `before` (`t_{p−1}`)
+/// to `end` (`t_p`) into `start` (the snapshot, or its image, a jump enters), drawn from
+/// `seed`; in a periodic section the pairings take their distances across the seam, as the
+/// exact one does.
 pub fn fresh_pool(
-    maps: BoundaryMaps,
+    redraws: Redraws,
     before: &Snapshot,
     end: &Snapshot,
     start: &Snapshot,
-    axis: AxialEnds,
     seed: u64,
-) -> Result<Option<Pool>, ExtrapolateError> {
+) -> Result<Pool, ExtrapolateError> {
     let d = start.mean_diameter();
     // what the pool's maps share, found once: the cells whose steps are redrawn, or the drift
     enum Redraw {
         Steps(BTreeMap<(i64, i64), Vec<usize>>),
         Drift(AxialDrift),
     }
-    let (pool, redraw) = match maps {
-        BoundaryMaps::Exact => return Ok(None),
-        BoundaryMaps::FreshSteps {
+    let (pool, axis, redraw) = match redraws {
+        Redraws::Steps {
             pool,
             cell_diameters,
+            axis,
         } => (
             pool,
+            axis,
             Redraw::Steps(cross_section_cells(&end.pos, cell_diameters * d)),
         ),
-        BoundaryMaps::FreshDrift {
+        Redraws::Drift {
             pool,
-            bin_diameters,
-            cell_diameters,
-            cap_zone_diameters,
+            grid_diameters,
+            ends,
         } => (
             pool,
+            ends.axis(),
             Redraw::Drift(AxialDrift::of(
                 before,
                 end,
-                bin_diameters * d,
-                cell_diameters * d,
-                cap_zone_diameters * d,
-                axis,
+                grid_diameters.scaled(d),
+                ends.scaled(d),
             )),
         ),
     };
@@ -421,7 +514,7 @@ pub fn fresh_pool(
         pairings.push(p.g);
     }
     let mean = means.iter().sum::<f64>() / means.len().max(1) as f64;
-    Ok(Some(Pool {
+    Ok(Pool {
         maps: pairings,
         summary: FreshPool {
             end: end.index,
@@ -431,7 +524,7 @@ pub fn fresh_pool(
             min_mean_distance_diameters: means.iter().copied().fold(f64::INFINITY, f64::min),
             max_mean_distance_diameters: means.iter().copied().fold(f64::NEG_INFINITY, f64::max),
         },
-    }))
+    })
 }
 
 /// Which pairing of a pool each jump uses: a stream of its own, seeded from the boundary's
@@ -459,6 +552,18 @@ impl PoolDraws {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn redraws(maps: BoundaryMaps) -> Redraws {
+        Redraws::of(maps, AxialEnds::Caps).unwrap().unwrap()
+    }
+
+    fn grid(bin: f64, cell: f64) -> DriftGrid {
+        DriftGrid { bin, cell }
+    }
+
+    fn caps(kept_zone: f64) -> DriftEnds {
+        DriftEnds::Caps { kept_zone }
+    }
 
     fn snapshot(index: u32, pos: Vec<[f64; 3]>) -> Snapshot {
         let n = pos.len();
@@ -626,9 +731,7 @@ mod tests {
                 pool: 16,
                 cell_diameters: cell / d,
             };
-            let pool = fresh_pool(steps, &start, &end, &start, AxialEnds::Caps, 3)
-                .unwrap()
-                .unwrap();
+            let pool = fresh_pool(redraws(steps), &start, &end, &start, 3).unwrap();
             let mut draws = PoolDraws::new(3);
             msd_after(&mut || pool.maps[draws.next(16)].clone(), k)
         };
@@ -693,9 +796,10 @@ mod tests {
         let start = snapshot(0, bed.iter().map(|&[x, y, z]| [x, y - 30.0, z]).collect());
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(12);
         let end = banded_drift(&start, &mut rng, |y| pairing::wrap(y, length));
-        let odd = AxialDrift::of(&start, &end, 7.0, 4.0, 0.0, axis);
+        let periodic = DriftEnds::Periodic { length };
+        let odd = AxialDrift::of(&start, &end, grid(7.0, 4.0), periodic);
         assert_eq!((odd.bins, odd.bin), (9, length / 9.0));
-        let recorded = AxialDrift::of(&start, &end, 2.0, 4.0, 0.0, axis);
+        let recorded = AxialDrift::of(&start, &end, grid(2.0, 4.0), periodic);
         assert_eq!(recorded.bins, 30);
         // the recorded drift carries the ±0.8 pattern
         let cell0 = &recorded.by_cell[&(0, 0)];
@@ -720,6 +824,32 @@ mod tests {
         assert!(offsets_seen.len() > 1, "{offsets_seen:?}");
     }
 
+    /// A section periodic along its axis has no caps: a cap zone there is refused when the
+    /// maps are planned, and a drift without one keeps the section's period.
+    #[test]
+    fn a_cap_zone_is_planned_only_between_caps() {
+        let drift = |cap_zone_diameters| BoundaryMaps::FreshDrift {
+            pool: 4,
+            bin_diameters: 2.0,
+            cell_diameters: 3.0,
+            cap_zone_diameters,
+        };
+        let periodic = AxialEnds::Periodic { length: 30.0 };
+        assert_eq!(Redraws::of(drift(2.5), periodic), Err(2.5));
+        let planned = |maps, axis| match Redraws::of(maps, axis) {
+            Ok(Some(Redraws::Drift { ends, .. })) => ends,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(
+            planned(drift(0.0), periodic),
+            DriftEnds::Periodic { length: 30.0 }
+        );
+        assert_eq!(
+            planned(drift(2.5), AxialEnds::Caps),
+            DriftEnds::Caps { kept_zone: 2.5 }
+        );
+    }
+
     #[test]
     fn the_drift_is_each_bins_mean_step_beyond_its_cells_mean() {
         // one cell of the cross-section; bins of 2 along the axis from the lowest end, y = 0
@@ -727,7 +857,7 @@ mod tests {
         let start = snapshot(0, at([-1.0, 0.5, 3.0, 5.0]));
         let end = snapshot(1, at([0.0, 1.5, 2.5, 5.0]));
         // steps 1, 1, −0.5, 0 (mean 0.375); ends in bins 0, 0, 1, 2
-        let drift = AxialDrift::of(&start, &end, 2.0, 3.0, 0.0, AxialEnds::Caps).by_cell;
+        let drift = AxialDrift::of(&start, &end, grid(2.0, 3.0), caps(0.0)).by_cell;
         assert_eq!(drift.len(), 1);
         let bins = &drift[&(0, 0)];
         let expected = [1.0 - 0.375, -0.5 - 0.375, 0.0 - 0.375];
@@ -746,7 +876,7 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
         let end = banded_drift(&start, &mut rng, |y| y.clamp(0.0, 60.0));
         let (bin, cell) = (2.0, 4.0);
-        let recorded = AxialDrift::of(&start, &end, bin, cell, 0.0, AxialEnds::Caps);
+        let recorded = AxialDrift::of(&start, &end, grid(bin, cell), caps(0.0));
         let drift = &recorded.by_cell;
         let spread = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64;
         let mut offsets_seen = std::collections::BTreeSet::new();
@@ -794,7 +924,7 @@ mod tests {
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(8);
         let end = banded_drift(&start, &mut rng, |y| y.clamp(0.0, 60.0));
         let (bin, cell, zone) = (2.0, 4.0, 8.0);
-        let drift = AxialDrift::of(&start, &end, bin, cell, zone, AxialEnds::Caps);
+        let drift = AxialDrift::of(&start, &end, grid(bin, cell), caps(zone));
         let (lowest, highest) = axial_extent(&end.pos);
         // the moved bins are those whose centre is at least `zone` from both ends of the bed
         let centre = |b: usize| lowest + (b as f64 + 0.5) * bin;
@@ -834,14 +964,14 @@ mod tests {
         }
         assert!(middle_moved, "the middle's drift is moved");
         // a zone reaching the middle from both caps keeps the whole drift: the recorded ends
-        let kept = AxialDrift::of(&start, &end, bin, cell, 31.0, AxialEnds::Caps);
+        let kept = AxialDrift::of(&start, &end, grid(bin, cell), caps(31.0));
         assert!(kept.moved.is_empty());
         let kept_ends = kept.moved_ends(&end, &mut rng);
         for (moved, recorded) in kept_ends.iter().zip(&end.pos) {
             assert!((moved[1] - recorded[1]).abs() < 1e-12);
         }
         // no zone moves every bin, as before there was one
-        let all = AxialDrift::of(&start, &end, bin, cell, 0.0, AxialEnds::Caps);
+        let all = AxialDrift::of(&start, &end, grid(bin, cell), caps(0.0));
         assert_eq!(all.moved, 0..all.bins);
     }
 
@@ -858,22 +988,9 @@ mod tests {
             pool: 4,
             cell_diameters: 3.0,
         };
-        let pool = |seed| {
-            fresh_pool(steps, &start, &end, &start, AxialEnds::Caps, seed)
-                .unwrap()
-                .unwrap()
-        };
+        let pool = |seed| fresh_pool(redraws(steps), &start, &end, &start, seed).unwrap();
         let (one, again, other) = (pool(9), pool(9), pool(10));
-        assert!(fresh_pool(
-            BoundaryMaps::Exact,
-            &start,
-            &end,
-            &start,
-            AxialEnds::Caps,
-            9
-        )
-        .unwrap()
-        .is_none());
+        assert_eq!(Redraws::of(BoundaryMaps::Exact, AxialEnds::Caps), Ok(None));
         assert_eq!(one.maps, again.maps);
         assert_ne!(one.maps, other.maps);
         assert_ne!(one.maps[0], one.maps[1]);

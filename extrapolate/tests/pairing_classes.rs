@@ -389,9 +389,10 @@ fn the_fresh_pools_keep_the_classes() {
     let mut rng = Rng::new(13);
     let (before, end) = (snapshot(0, &mut rng), snapshot(1, &mut rng));
     for maps in fresh_maps(4, 2.0) {
-        let pool = boundary::fresh_pool(maps, &before, &end, &before, boundary::AxialEnds::Caps, 3)
+        let redraws = boundary::Redraws::of(maps, boundary::AxialEnds::Caps)
             .unwrap()
             .unwrap();
+        let pool = boundary::fresh_pool(redraws, &before, &end, &before, 3).unwrap();
         assert_eq!(pool.maps.len(), 4);
         for g in &pool.maps {
             assert!(is_permutation(g));

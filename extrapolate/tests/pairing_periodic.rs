@@ -7,7 +7,7 @@
 mod common;
 
 use common::{fresh_maps, is_permutation, Rng};
-use extrapolate::boundary::{fresh_pool, AxialEnds};
+use extrapolate::boundary::{fresh_pool, AxialEnds, Redraws};
 use extrapolate::pairing::{
     pair, pair_by_size, pair_dense_periodic, respects_classes, Pairing, PairingError,
     PairingOptions,
@@ -519,13 +519,13 @@ fn fresh_boundary_maps_of_a_periodic_section_cross_the_seam() {
             exact.summary
         );
         let periodic = AxialEnds::Periodic { length: LENGTH };
-        let across = fresh_pool(maps, &t0, &t1, &t0, periodic, 5)
-            .unwrap()
-            .unwrap();
+        let pool_in = |axis| {
+            let redraws = Redraws::of(maps, axis).unwrap().unwrap();
+            fresh_pool(redraws, &t0, &t1, &t0, 5).unwrap()
+        };
+        let across = pool_in(periodic);
         assert!(across.maps.iter().all(|g| *g == exact.g), "{maps:?}");
-        let seam_blind = fresh_pool(maps, &t0, &t1, &t0, AxialEnds::Caps, 5)
-            .unwrap()
-            .unwrap();
+        let seam_blind = pool_in(AxialEnds::Caps);
         assert!(seam_blind.maps.iter().all(|g| *g != exact.g), "{maps:?}");
         let heat = (outcome.total_heat_end - outcome.total_heat_t1).abs() / outcome.total_heat_t1;
         assert!(heat < 1e-12, "{maps:?}: heat changed by {heat:e}");

@@ -6,7 +6,7 @@ use super::{
     axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck,
     Notice, TableChoice,
 };
-use crate::boundary::{self, AxialEnds, BoundaryMaps, Pool, PoolDraws};
+use crate::boundary::{self, AxialEnds, BoundaryMaps, Pool, PoolDraws, Redraws};
 use crate::cache;
 use crate::path::{self, RecurrencePolicy, Step};
 use crate::replay::{
@@ -63,6 +63,8 @@ pub(super) struct Extrapolation<'a> {
     mirror_check: Vec<MirrorCheck>,
     /// The boundary maps, with the seed they are drawn from.
     boundary: Boundary,
+    /// What the fresh maps redraw (`None`: the exact map).
+    redraws: Option<Redraws>,
     /// With fresh boundary maps: each start's pool of pairings.
     pools: Vec<(u32, Pool)>,
     /// Wall time of the pairings computed (and stored) by this run.
@@ -111,17 +113,12 @@ impl<'a> Extrapolation<'a> {
                 recording: request.recording.clone(),
             });
         }
-        if let BoundaryMaps::FreshDrift {
-            cap_zone_diameters, ..
-        } = request.boundary
-        {
-            if cap_zone_diameters > 0.0 && axial_period(&info).is_some() {
-                return Err(ExtrapolateError::CapZoneWithoutCaps {
-                    recording: request.recording.clone(),
-                    cap_zone_diameters,
-                });
-            }
-        }
+        let redraws = Redraws::of(request.boundary, AxialEnds::of(axial_period(&info))).map_err(
+            |cap_zone_diameters| ExtrapolateError::CapZoneWithoutCaps {
+                recording: request.recording.clone(),
+                cap_zone_diameters,
+            },
+        )?;
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
         let targets = jump_targets(request, used)?;
         let steps: Vec<Step> =
@@ -170,6 +167,7 @@ impl<'a> Extrapolation<'a> {
             pairings: Vec::new(),
             mirror_check: Vec::new(),
             boundary: request.boundary.with_seed(seed),
+            redraws,
             pools: Vec::new(),
             seconds_pairing: 0.0,
             pairing_reused: true,
@@ -248,21 +246,15 @@ impl<'a> Extrapolation<'a> {
     fn fresh_pools(&mut self) -> Result<Vec<(u32, Pool)>, ExtrapolateError> {
         let started = Instant::now();
         let before = &self.snaps[self.used as usize - 1];
-        let axis = AxialEnds::of(axial_period(&self.info));
         let mut pools = Vec::new();
+        let Some(redraws) = self.redraws else {
+            return Ok(pools);
+        };
         for p in &self.pairings {
             let start = start_image(&self.snaps, p.period, self.request.symmetry);
             let seed = self.seed.wrapping_add(u64::from(p.period));
-            if let Some(pool) = boundary::fresh_pool(
-                self.request.boundary,
-                before,
-                self.end(),
-                &start,
-                axis,
-                seed,
-            )? {
-                pools.push((p.period, pool));
-            }
+            let pool = boundary::fresh_pool(redraws, before, self.end(), &start, seed)?;
+            pools.push((p.period, pool));
         }
         self.seconds_pairing += started.elapsed().as_secs_f64();
         Ok(pools)
