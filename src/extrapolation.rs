@@ -3,6 +3,7 @@
 
 use crate::cli::ExtrapolatePlan;
 use anyhow::Result;
+use extrapolate::boundary::BoundaryMaps;
 use extrapolate::replay::memory::human_bytes;
 use extrapolate::replay::{self, MemoryPlan, ModeReason, ReplayError, TableMode};
 use extrapolate::sidecar::PairingSummary;
@@ -186,32 +187,29 @@ pub fn mirror_check_lines(checks: &[extrapolate::MirrorCheck]) -> Vec<String> {
     lines
 }
 
-/// The fresh boundary maps in plain words: what each jump draws, then each start's pool
-/// (nothing for the exact pairing, which the pairing line already tells).
-pub fn boundary_lines(boundary: Boundary, pools: &[FreshPool]) -> Vec<String> {
+/// What fresh boundary maps redraw, in words, without their seed (`None` for the exact
+/// map): the line `tdex extrapolate` and `tdex study horizon` print.
+pub fn boundary_settings(maps: BoundaryMaps) -> Option<String> {
     let sig = |x: f64| crate::fmt::sig(x, 3);
-    let what = match boundary {
-        Boundary::Exact => return Vec::new(),
-        Boundary::FreshSteps {
+    match maps {
+        BoundaryMaps::Exact => None,
+        BoundaryMaps::FreshSteps {
             pool,
             cell_diameters,
-            seed,
-        } => format!(
+        } => Some(format!(
             "fresh steps: each jump draws one of {pool} pairings in which every particle's \
-             step along the axis is redrawn within {}-diameter cells of the cross-section \
-             (seed {seed})",
+             step along the axis is redrawn within {}-diameter cells of the cross-section",
             sig(cell_diameters)
-        ),
-        Boundary::FreshDrift {
+        )),
+        BoundaryMaps::FreshDrift {
             pool,
             bin_diameters,
             cell_diameters,
             cap_zone_diameters,
-            seed,
-        } => format!(
+        } => Some(format!(
             "fresh drift: each jump draws one of {pool} pairings in which the period's axial \
              drift ({}-diameter bins, {}-diameter cells of the cross-section) is moved along \
-             the axis{} (seed {seed})",
+             the axis{}",
             sig(bin_diameters),
             sig(cell_diameters),
             if cap_zone_diameters > 0.0 {
@@ -222,8 +220,17 @@ pub fn boundary_lines(boundary: Boundary, pools: &[FreshPool]) -> Vec<String> {
             } else {
                 String::new()
             }
-        ),
+        )),
+    }
+}
+
+/// The fresh boundary maps in plain words: what each jump draws, then each start's pool
+/// (nothing for the exact pairing, which the pairing line already tells).
+pub fn boundary_lines(boundary: Boundary, pools: &[FreshPool]) -> Vec<String> {
+    let (Some(what), Some(seed)) = (boundary_settings(boundary.into()), boundary.seed()) else {
+        return Vec::new();
     };
+    let what = format!("{what} (seed {seed})");
     let mut lines = vec![what];
     lines.extend(pools.iter().map(|p| {
         format!(

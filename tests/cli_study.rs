@@ -584,4 +584,17 @@ fn horizon_study_runs_every_p_with_each_boundary_and_its_settings() {
         } => assert_eq!((pool, cap_zone_diameters), (4, 1.0)),
         other => panic!("{other:?}"),
     }
+    // and the study names them once, in its JSON and beside its table
+    let named = with_settings["boundary_maps"].as_array().unwrap();
+    assert_eq!(named.len(), 1, "{named:?}");
+    let words = named[0].as_str().unwrap();
+    assert!(
+        words.starts_with("fresh drift: each jump draws one of 4 pairings")
+            && words.ends_with("but within 1 diameters of an end cap, where it is kept"),
+        "{words}"
+    );
+    let md = std::fs::read_to_string(set.join("study.md")).unwrap();
+    assert!(md.contains(words), "{md}");
+    // with the exact pairing alone there is nothing to name
+    assert!(plain.get("boundary_maps").is_none(), "{plain}");
 }

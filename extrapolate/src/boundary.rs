@@ -103,6 +103,35 @@ impl BoundaryMaps {
     }
 }
 
+impl From<Boundary> for BoundaryMaps {
+    /// The maps a file's boundary records, without the seed they were drawn from.
+    fn from(boundary: Boundary) -> Self {
+        match boundary {
+            Boundary::Exact => BoundaryMaps::Exact,
+            Boundary::FreshSteps {
+                pool,
+                cell_diameters,
+                ..
+            } => BoundaryMaps::FreshSteps {
+                pool,
+                cell_diameters,
+            },
+            Boundary::FreshDrift {
+                pool,
+                bin_diameters,
+                cell_diameters,
+                cap_zone_diameters,
+                ..
+            } => BoundaryMaps::FreshDrift {
+                pool,
+                bin_diameters,
+                cell_diameters,
+                cap_zone_diameters,
+            },
+        }
+    }
+}
+
 /// The fresh maps asked of one recording, checked against how its axis ends: what each
 /// start's pool redraws (lengths in particle diameters). A cap zone exists only between
 /// end caps.

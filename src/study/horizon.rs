@@ -83,6 +83,10 @@ struct HorizonStudy {
     tau: f64,
     /// The seed of the recurrence paths (null: the case's seed, the default).
     path_seed: Option<u64>,
+    /// What each fresh boundary map of the runs redraws, in words (left out with the exact
+    /// pairing alone): the settings every draw's runs share.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    boundary_maps: Vec<String>,
     runs: Vec<Entry>,
     /// With several recordings: each draw's recording (the study's first), and per P (and
     /// image) the pooled verdict over them; both left out with one recording.
@@ -266,6 +270,10 @@ pub fn run(
         twins: info.twins,
         tau: info.tau,
         path_seed: seed,
+        boundary_maps: boundaries
+            .iter()
+            .filter_map(|&maps| extrapolation::boundary_settings(maps))
+            .collect(),
         runs,
         draws: if several {
             recordings.iter().map(|r| r.display().to_string()).collect()
@@ -444,6 +452,9 @@ fn table(s: &HorizonStudy) -> String {
                 super::pct(e.floor_eps_rel_last)
             ),
         );
+    }
+    for settings in &s.boundary_maps {
+        t += &format!("{settings}\n");
     }
     for e in &s.runs {
         t += &format!("{}: {}\n", e.label(), e.verdict);

@@ -163,6 +163,14 @@ impl Boundary {
     pub fn is_exact(&self) -> bool {
         *self == Boundary::Exact
     }
+
+    /// The seed fresh maps were drawn from (`None` for the exact map).
+    pub fn seed(&self) -> Option<u64> {
+        match self {
+            Boundary::Exact => None,
+            Boundary::FreshSteps { seed, .. } | Boundary::FreshDrift { seed, .. } => Some(*seed),
+        }
+    }
 }
 
 /// The pool of fresh pairings to one start: how far its pairings move the particles, in
