@@ -381,15 +381,44 @@ impl Checkpoint<'static> {
 
     /// Rebuilds the simulation of `case` with the saved state, after checking that every
     /// index the engine and the recorder will follow is in range (a checkpoint that passed
-    /// its CRC can still have been written by hand). `period_steps`, `recorded_periods` and
-    /// `reference_periods` bound the stage; `path` is for messages.
+    /// its CRC can still have been written by hand). `path` is for messages.
     pub fn restore(self, case: &Case, path: &Path) -> Result<Restored, CheckpointError> {
         let bad = |detail: String| CheckpointError::Inconsistent {
             path: path.to_path_buf(),
             detail,
         };
         let sim = Simulation::new(case).map_err(|e| bad(e.to_string()))?;
-        let n = sim.particles.len();
+        let snapshots = self.stage_snapshots(case).map_err(&bad)?;
+        match (&self.output, snapshots) {
+            (None, None) => {}
+            (Some(out), Some(count)) => self.check_output(out, count, case, &sim).map_err(&bad)?,
+            (out, _) => {
+                return Err(bad(format!(
+                    "stage {:?} {} recording state",
+                    self.stage,
+                    if out.is_some() { "has a" } else { "lacks the" }
+                )))
+            }
+        }
+        let mut output = self.output;
+        let t1 = match output.as_mut().and_then(|o| o.t1_engine.take()) {
+            Some(e) => Some(apply(e, sim.clone(), case, &bad)?),
+            None => None,
+        };
+        let sim = apply(self.engine, sim, case, &bad)?;
+        Ok(Restored {
+            sim,
+            stage: self.stage,
+            elapsed: self.elapsed,
+            output,
+            t1,
+        })
+    }
+
+    /// How many snapshots the recording state holds at the saved stage (`None` before t0,
+    /// where there is none), once the stage is checked to lie within the run the options
+    /// and `case` describe; `Err` says how it does not.
+    fn stage_snapshots(&self, case: &Case) -> Result<Option<usize>, String> {
         let o = &self.options;
         let (settle, spin) = (
             case.steps_in(case.time.settle),
@@ -419,119 +448,106 @@ impl Checkpoint<'static> {
             ),
         };
         if !(1..=tdex_format::MAX_RECORDED_PERIODS).contains(&recorded) || !stage_ok {
-            return Err(bad(format!(
+            return Err(format!(
                 "stage {:?} is outside the run ({settle} settling, {spin} spin-up steps, {recorded} recorded periods of {} steps sampled every {}, {} reference periods)",
                 self.stage, o.period_steps, o.sample_every, o.reference_periods
-            )));
+            ));
         }
-        match (&self.output, snapshots) {
-            (None, None) => {}
-            (Some(out), Some(count)) => {
-                if out.snapshots.len() != count {
-                    return Err(bad(format!(
-                        "{} snapshots stored at stage {:?}, {count} expected",
-                        out.snapshots.len(),
-                        self.stage
-                    )));
-                }
-                if let Some(s) = out.snapshots.iter().find(|s| {
-                    [
-                        s.id.len(),
-                        s.pos.len(),
-                        s.radius.len(),
-                        s.temp.len(),
-                        s.vel.len(),
-                    ]
-                    .iter()
-                    .any(|&len| len != n)
-                }) {
-                    return Err(bad(format!(
-                        "snapshot {} does not hold {n} particles",
-                        s.index
-                    )));
-                }
-                if out.run.particles as usize != n || out.run.walls.len() != sim.walls.len() {
-                    return Err(bad(format!(
-                        "the recording's {} particles and {} walls differ from the case's {n} and {}",
-                        out.run.particles,
-                        out.run.walls.len(),
-                        sim.walls.len()
-                    )));
-                }
-                let s = &out.sampler;
-                if s.every != o.sample_every || s.max_duration != o.dtc_max_steps {
-                    return Err(bad(format!(
-                        "the sampler has n = {}, Δt_c^max = {}; the options say {} and {}",
-                        s.every, s.max_duration, o.sample_every, o.dtc_max_steps
-                    )));
-                }
-                s.check(o.period_steps / o.sample_every.max(1) as u64)
-                    .map_err(&bad)?;
-                // the main run's snapshots are numbered by position, each twin's from 2
-                let references = o.reference_periods.max(1) as usize;
-                let expected = |k: usize| match k.checked_sub(own) {
-                    None => k,
-                    Some(past) => 2 + past % references,
-                };
-                if let Some((k, s)) = out
-                    .snapshots
-                    .iter()
-                    .enumerate()
-                    .find(|(k, s)| s.index as usize != expected(*k))
-                {
-                    return Err(bad(format!("snapshot {k} is numbered {}", s.index)));
-                }
-                // the state at t1 is kept from t1 on while twins are still to run from it
-                let keeps_t1 = match self.stage {
-                    Stage::Period { period, .. } => period >= o.twins_from && o.twins > 0,
-                    Stage::Reference { .. } => o.twins > 0,
-                    Stage::Twin { .. } => true,
-                    _ => false,
-                };
-                if out.t1_engine.is_some() != keeps_t1 {
-                    return Err(bad(format!(
-                        "stage {:?} with {} twins {} the engine state at t1",
-                        self.stage,
-                        o.twins,
-                        if out.t1_engine.is_some() {
-                            "has"
-                        } else {
-                            "lacks"
-                        }
-                    )));
-                }
-                let (t0_step, r) = (settle + spin, case.particles.largest_radius());
-                if out.run.step_t0 != t0_step
-                    || out.run.t0 != t0_step as f64 * case.time.dt
-                    || out.run.r_max != r
-                {
-                    return Err(bad(format!(
-                        "t0 at step {} ({} s) with largest radius {} m; the case gives step {t0_step} and {r} m",
-                        out.run.step_t0, out.run.t0, out.run.r_max
-                    )));
-                }
-            }
-            (out, _) => {
-                return Err(bad(format!(
-                    "stage {:?} {} recording state",
-                    self.stage,
-                    if out.is_some() { "has a" } else { "lacks the" }
-                )))
-            }
+        Ok(snapshots)
+    }
+
+    /// Checks the recording state `out` against the stage (`count` snapshots), the options,
+    /// `case` and its simulation `sim`; `Err` says what differs.
+    fn check_output(
+        &self,
+        out: &OutputState,
+        count: usize,
+        case: &Case,
+        sim: &Simulation,
+    ) -> Result<(), String> {
+        let (o, n) = (&self.options, sim.particles.len());
+        if out.snapshots.len() != count {
+            return Err(format!(
+                "{} snapshots stored at stage {:?}, {count} expected",
+                out.snapshots.len(),
+                self.stage
+            ));
         }
-        let mut output = self.output;
-        let t1 = match output.as_mut().and_then(|o| o.t1_engine.take()) {
-            Some(e) => Some(apply(e, sim.clone(), case, &bad)?),
-            None => None,
+        if let Some(s) = out.snapshots.iter().find(|s| {
+            [
+                s.id.len(),
+                s.pos.len(),
+                s.radius.len(),
+                s.temp.len(),
+                s.vel.len(),
+            ]
+            .iter()
+            .any(|&len| len != n)
+        }) {
+            return Err(format!("snapshot {} does not hold {n} particles", s.index));
+        }
+        if out.run.particles as usize != n || out.run.walls.len() != sim.walls.len() {
+            return Err(format!(
+                "the recording's {} particles and {} walls differ from the case's {n} and {}",
+                out.run.particles,
+                out.run.walls.len(),
+                sim.walls.len()
+            ));
+        }
+        let s = &out.sampler;
+        if s.every != o.sample_every || s.max_duration != o.dtc_max_steps {
+            return Err(format!(
+                "the sampler has n = {}, Δt_c^max = {}; the options say {} and {}",
+                s.every, s.max_duration, o.sample_every, o.dtc_max_steps
+            ));
+        }
+        s.check(o.period_steps / o.sample_every.max(1) as u64)?;
+        // the main run's snapshots are numbered by position, each twin's from 2
+        let own = o.last_snapshot() as usize + 1;
+        let references = o.reference_periods.max(1) as usize;
+        let expected = |k: usize| match k.checked_sub(own) {
+            None => k,
+            Some(past) => 2 + past % references,
         };
-        let sim = apply(self.engine, sim, case, &bad)?;
-        Ok(Restored {
-            sim,
-            stage: self.stage,
-            elapsed: self.elapsed,
-            output,
-            t1,
-        })
+        if let Some((k, s)) = out
+            .snapshots
+            .iter()
+            .enumerate()
+            .find(|(k, s)| s.index as usize != expected(*k))
+        {
+            return Err(format!("snapshot {k} is numbered {}", s.index));
+        }
+        // the state at t1 is kept from t1 on while twins are still to run from it
+        let keeps_t1 = match self.stage {
+            Stage::Period { period, .. } => period >= o.twins_from && o.twins > 0,
+            Stage::Reference { .. } => o.twins > 0,
+            Stage::Twin { .. } => true,
+            _ => false,
+        };
+        if out.t1_engine.is_some() != keeps_t1 {
+            return Err(format!(
+                "stage {:?} with {} twins {} the engine state at t1",
+                self.stage,
+                o.twins,
+                if out.t1_engine.is_some() {
+                    "has"
+                } else {
+                    "lacks"
+                }
+            ));
+        }
+        let t0_step = case.steps_in(case.time.settle) + case.steps_in(case.time.spin_up);
+        let r = case.particles.largest_radius();
+        if out.run.step_t0 != t0_step
+            || out.run.t0 != t0_step as f64 * case.time.dt
+            || out.run.r_max != r
+        {
+            return Err(format!(
+                "t0 at step {} ({} s) with largest radius {} m; the case gives step {t0_step} and {r} m",
+                out.run.step_t0, out.run.t0, out.run.r_max
+            ));
+        }
+        Ok(())
     }
 }
 
