@@ -14,6 +14,7 @@ use crate::periodic::AxialPeriod;
 use crate::slices::{for_each_task, pieces_at, slices_indexed_alike};
 use crate::wall::WallSet;
 use rayon::prelude::*;
+use std::ops::Range;
 
 /// Particles per parallel task when the list entries are counted (the fill goes by layer).
 const BLOCK: usize = 512;
@@ -166,37 +167,8 @@ impl NeighborList {
     pub fn rebuild(&mut self, particles: &mut ParticleSet, grid: &CellGrid, walls: &WallSet) {
         let n = particles.len();
         self.carry_open_contacts(&particles.id);
-
-        // 1. stable counting sort by cell: ties keep their previous order (deterministic)
-        particles
-            .pos
-            .par_iter()
-            .map(|&p| grid.index(grid.coords(p)) as u32)
-            .collect_into_vec(&mut self.cell_of);
-        self.cell_start.clear();
-        self.cell_start.resize(grid.cell_count() + 1, 0);
-        for &c in &self.cell_of {
-            self.cell_start[c as usize + 1] += 1;
-        }
-        for c in 0..grid.cell_count() {
-            self.cell_start[c + 1] += self.cell_start[c];
-        }
-        self.order.clear();
-        self.order.resize(n, 0);
-        // the cell starts advance as slots are handed out, then step back by one cell
-        for (old, &c) in self.cell_of.iter().enumerate() {
-            self.order[self.cell_start[c as usize] as usize] = old as u32;
-            self.cell_start[c as usize] += 1;
-        }
-        self.cell_start.rotate_right(1);
-        self.cell_start[0] = 0;
-        particles.permute_state(&self.order, &mut self.permute_scratch);
-        let per_layer = grid.cells_per_layer();
-        self.layer_start.clear();
-        self.layer_start
-            .extend((0..=grid.layers()).map(|l| self.cell_start[l * per_layer]));
-
-        // 2. count each slot's partners and wall candidates, then fill the lists in place
+        self.sort_into_cells(particles, grid);
+        // count each slot's partners and wall candidates, then fill the lists in place
         let search = Search {
             grid,
             cell_start: &self.cell_start,
@@ -256,42 +228,8 @@ impl NeighborList {
             },
         };
         let fill = |l: usize, pieces: FillPieces| {
-            let FillPieces {
-                partners: partner,
-                pairs:
-                    ListPieces {
-                        histories: history,
-                        touching: touch,
-                    },
-                wall_index: wall,
-                walls:
-                    ListPieces {
-                        histories: wall_history,
-                        touching: wall_touch,
-                    },
-            } = pieces;
-            let (mut e, mut w, mut packed) = (0, 0, 0);
-            for i in layer_start[l] as usize..layer_start[l + 1] as usize {
-                search.partners(i, |j, now_touching| {
-                    // a history matters only to a pair touching now (the pair stage's
-                    // own test): it resets the others
-                    let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
-                    partner[e] = j as u32;
-                    touch[e] = h.is_some();
-                    if let Some(h) = h {
-                        history[packed] = h;
-                        packed += 1;
-                    }
-                    e += 1;
-                });
-                search.walls(i, |k| {
-                    let h = carried.find(ids[i], n as u32 + k as u32);
-                    wall[w] = k as u8;
-                    wall_history[w] = h.unwrap_or_default();
-                    wall_touch[w] = h.is_some();
-                    w += 1;
-                });
-            }
+            let slots = layer_start[l] as usize..layer_start[l + 1] as usize;
+            fill_layer(slots, &search, ids, carried, pieces);
             0
         };
         for_each_task(
@@ -304,17 +242,42 @@ impl NeighborList {
 
         self.pos_at_build.clear();
         self.pos_at_build.extend_from_slice(&particles.pos);
-        let (r0, m0) = (particles.radius.first(), particles.mass.first());
-        self.uniform_pair = match (r0, m0) {
-            (Some(&r), Some(&m))
-                if particles.radius.iter().all(|&x| x == r)
-                    && particles.mass.iter().all(|&x| x == m) =>
-            {
-                Some(effective(r, r, m, m))
-            }
-            _ => None,
-        };
+        self.uniform_pair = uniform_pair(particles);
         self.rebuilds += 1;
+    }
+
+    /// Re-sorts `particles` into the order of `grid`'s cells (a stable counting sort: ties
+    /// keep their previous order, so the order is deterministic) and notes where each cell
+    /// and layer starts.
+    fn sort_into_cells(&mut self, particles: &mut ParticleSet, grid: &CellGrid) {
+        let n = particles.len();
+        particles
+            .pos
+            .par_iter()
+            .map(|&p| grid.index(grid.coords(p)) as u32)
+            .collect_into_vec(&mut self.cell_of);
+        self.cell_start.clear();
+        self.cell_start.resize(grid.cell_count() + 1, 0);
+        for &c in &self.cell_of {
+            self.cell_start[c as usize + 1] += 1;
+        }
+        for c in 0..grid.cell_count() {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.order.clear();
+        self.order.resize(n, 0);
+        // the cell starts advance as slots are handed out, then step back by one cell
+        for (old, &c) in self.cell_of.iter().enumerate() {
+            self.order[self.cell_start[c as usize] as usize] = old as u32;
+            self.cell_start[c as usize] += 1;
+        }
+        self.cell_start.rotate_right(1);
+        self.cell_start[0] = 0;
+        particles.permute_state(&self.order, &mut self.permute_scratch);
+        let per_layer = grid.cells_per_layer();
+        self.layer_start.clear();
+        self.layer_start
+            .extend((0..=grid.layers()).map(|l| self.cell_start[l * per_layer]));
     }
 
     /// Checks a list read back from a checkpoint against `n` particles, the grid's `layers`
@@ -456,6 +419,69 @@ pieces_at!(FillPieces at ListStart {
     wall_index: wall_candidate,
     walls: wall_candidate
 });
+
+/// `(R*, m*)` of every pair when all spheres are equal (`None` otherwise): the pair stage
+/// then skips computing them per contact.
+fn uniform_pair(particles: &ParticleSet) -> Option<(f64, f64)> {
+    let (r0, m0) = (particles.radius.first(), particles.mass.first());
+    match (r0, m0) {
+        (Some(&r), Some(&m))
+            if particles.radius.iter().all(|&x| x == r)
+                && particles.mass.iter().all(|&x| x == m) =>
+        {
+            Some(effective(r, r, m, m))
+        }
+        _ => None,
+    }
+}
+
+/// Fills the entries and wall candidates of a layer's `slots` into its `pieces`, with the
+/// histories `carried` over from the last list (`ids`: the particles' ids by slot); the
+/// layer's pair histories are packed from its first entry on.
+fn fill_layer(
+    slots: Range<usize>,
+    search: &Search,
+    ids: &[u32],
+    carried: &Carried,
+    pieces: FillPieces,
+) {
+    let FillPieces {
+        partners: partner,
+        pairs: ListPieces {
+            histories: history,
+            touching: touch,
+        },
+        wall_index: wall,
+        walls:
+            ListPieces {
+                histories: wall_history,
+                touching: wall_touch,
+            },
+    } = pieces;
+    let n = ids.len() as u32;
+    let (mut e, mut w, mut packed) = (0, 0, 0);
+    for i in slots {
+        search.partners(i, |j, now_touching| {
+            // a history matters only to a pair touching now (the pair stage's own test): it
+            // resets the others
+            let h = now_touching.then(|| carried.pair(ids[i], ids[j])).flatten();
+            partner[e] = j as u32;
+            touch[e] = h.is_some();
+            if let Some(h) = h {
+                history[packed] = h;
+                packed += 1;
+            }
+            e += 1;
+        });
+        search.walls(i, |k| {
+            let h = carried.find(ids[i], n + k as u32);
+            wall[w] = k as u8;
+            wall_history[w] = h.unwrap_or_default();
+            wall_touch[w] = h.is_some();
+            w += 1;
+        });
+    }
+}
 
 /// The broad-phase search over particles already in cell order.
 struct Search<'a> {
