@@ -70,32 +70,7 @@ pub fn import(
     opts: &RecordOptions,
     dest: &Path,
 ) -> Result<ImportReport, ImportError> {
-    match (case.drum.wall_temperature, &dumps.walls) {
-        (Some(temperature), None) => {
-            return Err(ImportError::HeatedMantleWithoutWallDumps {
-                case: case_path.to_path_buf(),
-                temperature,
-            })
-        }
-        (None, Some(walls)) => {
-            return Err(ImportError::WallDumpsWithoutHeatedMantle {
-                case: case_path.to_path_buf(),
-                pattern: walls.pattern.clone(),
-            })
-        }
-        _ => {}
-    }
-    if let Some(w) = dumps
-        .walls
-        .as_ref()
-        .filter(|w| w.mantle_mesh >= DRUM_MESHES)
-    {
-        return Err(ImportError::Case(format!(
-            "the mantle's mesh id {} is not one of the drum's {DRUM_MESHES} meshes (0, 1: \
-             their places in `fix wall/gran ... meshes`)",
-            w.mantle_mesh
-        )));
-    }
+    check_dumps(case, case_path, dumps)?;
     let mut sampler =
         ContactSampler::new(opts.sample_every, opts.dtc_max_steps).ok_or_else(|| {
             ImportError::Case(format!(
@@ -106,17 +81,7 @@ pub fn import(
     let atoms = read_snapshots(&dumps.atoms, opts.period_steps, case.time.dt)?;
     let t0 = &atoms.snapshots[0];
     let particles = t0.len() as u32;
-    if t0.len() != case.particles.count {
-        return Err(ImportError::Case(format!(
-            "{}: particles.count = {} but the atom dump at t0 (timestep {}, {}) holds {} \
-             particles: give the case the particle count of the LIGGGHTS run",
-            case_path.display(),
-            case.particles.count,
-            atoms.step_t0,
-            atoms.files_t0,
-            t0.len()
-        )));
-    }
+    check_particle_count(case, case_path, &atoms)?;
     let mut walls = WallSet::of_drum(&case.drum);
     walls.mantle_temperature = case.drum.wall_temperature;
     let run = RunAtT0 {
@@ -142,15 +107,7 @@ pub fn import(
     let contacts = Contacts {
         ids: &atoms.ids,
         radius: &t0.radius,
-        law: ConductionLaw::new(
-            &case.conduction,
-            case.material.conductivity,
-            case.drum
-                .wall_conductivity
-                .unwrap_or(case.material.conductivity),
-            case.material.heat_capacity,
-            case.material.youngs_modulus,
-        ),
+        law: conduction_law(case),
     };
     let (step_t0, every) = (atoms.step_t0, opts.sample_every as u64);
     // no overflow: the atom dumps hold t1 = t0 + τ, a timestep ≤ dump::MAX_TIMESTEP
@@ -207,6 +164,72 @@ pub fn import(
         wall_frames: wall_frames.map(|(frames, _)| frames.sampled),
         wall_contacts_merged: merged,
     })
+}
+
+/// The wall dumps are there exactly when the case heats its mantle, and name one of the
+/// drum's meshes as the mantle.
+fn check_dumps(case: &Case, case_path: &Path, dumps: &Dumps) -> Result<(), ImportError> {
+    match (case.drum.wall_temperature, &dumps.walls) {
+        (Some(temperature), None) => {
+            return Err(ImportError::HeatedMantleWithoutWallDumps {
+                case: case_path.to_path_buf(),
+                temperature,
+            })
+        }
+        (None, Some(walls)) => {
+            return Err(ImportError::WallDumpsWithoutHeatedMantle {
+                case: case_path.to_path_buf(),
+                pattern: walls.pattern.clone(),
+            })
+        }
+        _ => {}
+    }
+    if let Some(w) = dumps
+        .walls
+        .as_ref()
+        .filter(|w| w.mantle_mesh >= DRUM_MESHES)
+    {
+        return Err(ImportError::Case(format!(
+            "the mantle's mesh id {} is not one of the drum's {DRUM_MESHES} meshes (0, 1: \
+             their places in `fix wall/gran ... meshes`)",
+            w.mantle_mesh
+        )));
+    }
+    Ok(())
+}
+
+/// The atom dump at t0 holds the case's particle count.
+fn check_particle_count(
+    case: &Case,
+    case_path: &Path,
+    atoms: &AtomSnapshots,
+) -> Result<(), ImportError> {
+    let at_t0 = atoms.snapshots[0].len();
+    if at_t0 != case.particles.count {
+        return Err(ImportError::Case(format!(
+            "{}: particles.count = {} but the atom dump at t0 (timestep {}, {}) holds {} \
+             particles: give the case the particle count of the LIGGGHTS run",
+            case_path.display(),
+            case.particles.count,
+            atoms.step_t0,
+            atoms.files_t0,
+            at_t0
+        )));
+    }
+    Ok(())
+}
+
+/// The case's conduction law, the mantle's conductivity that of the particles unless given.
+fn conduction_law(case: &Case) -> ConductionLaw {
+    ConductionLaw::new(
+        &case.conduction,
+        case.material.conductivity,
+        case.drum
+            .wall_conductivity
+            .unwrap_or(case.material.conductivity),
+        case.material.heat_capacity,
+        case.material.youngs_modulus,
+    )
 }
 
 /// The timesteps a period's samples are dumped at: `t0 + n, t0 + 2n, …, t1`.
