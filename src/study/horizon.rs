@@ -171,34 +171,7 @@ pub fn run(
     images: &[Symmetry],
     boundaries: &[BoundaryMaps],
 ) -> Result<()> {
-    let dir = &plan.output;
-    let recording = match source {
-        HorizonSource::Recording(path) => path.clone(),
-        HorizonSource::Record(options) => {
-            let path = dir.join("horizon.mcap");
-            if !plan.json {
-                println!(
-                    "record        {} periods and {} reference periods with {} DEM twins (the \
-                     DEM runs once; this is the long part)",
-                    options.recorded_periods, options.reference_periods, options.twins
-                );
-            }
-            let bar = super::dem_bar(plan.json, "study");
-            crate::with_workers(plan.threads, || {
-                Ok(record::record(
-                    &plan.case,
-                    &plan.case_path,
-                    &plan.case_toml,
-                    options,
-                    &path,
-                    &mut super::on_phase_logged(&bar),
-                )?)
-            })
-            .with_context(|| format!("recording {}", plan.case_path.display()))?;
-            bar.finish_and_clear();
-            path
-        }
-    };
+    let recording = recording_of(plan, source)?;
     let recordings: Vec<PathBuf> = std::iter::once(recording.clone())
         .chain(draws.iter().cloned())
         .collect();
@@ -217,49 +190,14 @@ pub fn run(
     let mut info = None;
     for (path, name) in recordings.iter().zip(&names) {
         let rec = RecordingReader::open(path)?;
-        let held = rec.info().recorded_periods;
-        if let Some(&p) = recorded_periods.iter().find(|&&p| p > held) {
-            bail!(
-                "{}: holds {held} recorded period(s); --recorded-periods {p} cannot be replayed \
-                 from it",
-                path.display(),
-            );
-        }
         // with one recording the files keep their names; with several each draw's name
         // ends them
         let draw = several.then_some(name.as_str());
-        let mut entries = Vec::with_capacity(configurations.len());
-        for &(p, symmetry, maps) in &configurations {
-            entries.push(run_one(plan, &rec, path, draw, (p, symmetry, maps), seed)?);
-        }
+        by_draw.push(run_draw(plan, &rec, path, draw, &configurations, seed)?);
         info.get_or_insert_with(|| rec.info().clone());
-        by_draw.push(entries);
     }
     let info = info.expect("one recording at least");
-    // the table's order: configuration by configuration, the draws of each together
-    let mut by_draw: Vec<std::vec::IntoIter<Entry>> =
-        by_draw.into_iter().map(Vec::into_iter).collect();
-    let mut runs = Vec::new();
-    let mut pooled = Vec::new();
-    for &(p, symmetry, maps) in &configurations {
-        let entries: Vec<Entry> = by_draw
-            .iter_mut()
-            .map(|d| d.next().expect("one entry per configuration"))
-            .collect();
-        if several {
-            let each = entries
-                .iter()
-                .map(|e| Draw::of(&e.comparison))
-                .collect::<Result<Vec<_>, _>>()?;
-            pooled.push(PooledRun {
-                recorded_periods: p,
-                symmetry,
-                boundary: boundary_name(maps),
-                draws: Draws::pool(each)?,
-            });
-        }
-        runs.extend(entries);
-    }
+    let (runs, pooled) = in_table_order(by_draw, &configurations)?;
     let study = HorizonStudy {
         study: "horizon",
         case: plan.case_path.display().to_string(),
@@ -290,6 +228,97 @@ pub fn run(
         &markdown(&study, &table),
         svgs(&study)?,
     )
+}
+
+/// The runs in the table's order, configuration by configuration with the draws of each
+/// together (`by_draw`: per draw, every configuration in order), and with several draws
+/// each configuration's pooled verdict.
+fn in_table_order(
+    by_draw: Vec<Vec<Entry>>,
+    configurations: &[(u32, Symmetry, BoundaryMaps)],
+) -> Result<(Vec<Entry>, Vec<PooledRun>)> {
+    let several = by_draw.len() > 1;
+    let mut by_draw: Vec<std::vec::IntoIter<Entry>> =
+        by_draw.into_iter().map(Vec::into_iter).collect();
+    let mut runs = Vec::new();
+    let mut pooled = Vec::new();
+    for &(p, symmetry, maps) in configurations {
+        let entries: Vec<Entry> = by_draw
+            .iter_mut()
+            .map(|d| d.next().expect("one entry per configuration"))
+            .collect();
+        if several {
+            let each = entries
+                .iter()
+                .map(|e| Draw::of(&e.comparison))
+                .collect::<Result<Vec<_>, _>>()?;
+            pooled.push(PooledRun {
+                recorded_periods: p,
+                symmetry,
+                boundary: boundary_name(maps),
+                draws: Draws::pool(each)?,
+            });
+        }
+        runs.extend(entries);
+    }
+    Ok((runs, pooled))
+}
+
+/// The study's recording: the one given, or one recorded now into the output directory
+/// (the long part).
+fn recording_of(plan: &StudyPlan, source: &HorizonSource) -> Result<PathBuf> {
+    let dir = &plan.output;
+    Ok(match source {
+        HorizonSource::Recording(path) => path.clone(),
+        HorizonSource::Record(options) => {
+            let path = dir.join("horizon.mcap");
+            if !plan.json {
+                println!(
+                    "record        {} periods and {} reference periods with {} DEM twins (the \
+                     DEM runs once; this is the long part)",
+                    options.recorded_periods, options.reference_periods, options.twins
+                );
+            }
+            let bar = super::dem_bar(plan.json, "study");
+            crate::with_workers(plan.threads, || {
+                Ok(record::record(
+                    &plan.case,
+                    &plan.case_path,
+                    &plan.case_toml,
+                    options,
+                    &path,
+                    &mut super::on_phase_logged(&bar),
+                )?)
+            })
+            .with_context(|| format!("recording {}", plan.case_path.display()))?;
+            bar.finish_and_clear();
+            path
+        }
+    })
+}
+
+/// Every configuration `(P, image, boundary maps)` run on one draw `rec` (at `path`), in
+/// order, after checking that the recording holds the largest P asked.
+fn run_draw(
+    plan: &StudyPlan,
+    rec: &RecordingReader,
+    path: &Path,
+    draw: Option<&str>,
+    configurations: &[(u32, Symmetry, BoundaryMaps)],
+    seed: Option<u64>,
+) -> Result<Vec<Entry>> {
+    let held = rec.info().recorded_periods;
+    if let Some(&(p, ..)) = configurations.iter().find(|&&(p, ..)| p > held) {
+        bail!(
+            "{}: holds {held} recorded period(s); --recorded-periods {p} cannot be replayed \
+             from it",
+            path.display(),
+        );
+    }
+    configurations
+        .iter()
+        .map(|&configuration| run_one(plan, rec, path, draw, configuration, seed))
+        .collect()
 }
 
 /// Extrapolates the first `p` recorded periods of `rec` (at `path`) with `symmetry` and the
