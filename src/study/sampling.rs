@@ -7,6 +7,7 @@ use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
 use recorder::record::{self, RecordJob, RecordOptions};
 use serde::Serialize;
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Debug, Serialize)]
@@ -75,48 +76,8 @@ pub fn run(
         runs[0].period_steps
     ));
 
-    let bar = super::dem_bar(plan.json, "study");
-    let started = Instant::now();
-    let seconds_to_t0 = crate::with_workers(plan.threads, || {
-        let mut progress = super::on_phase_logged(&bar);
-        let mut sim = record::run_to_t0(&plan.case, &mut progress)?;
-        let seconds_to_t0 = started.elapsed().as_secs_f64();
-        let jobs: Vec<RecordJob> = runs
-            .iter()
-            .zip(&paths)
-            .map(|(o, (rec, _))| RecordJob {
-                options: o.clone(),
-                dest: rec,
-            })
-            .collect();
-        record::record_many_from_t0(
-            &mut sim,
-            &plan.case_path,
-            &plan.case_toml,
-            &jobs,
-            seconds_to_t0,
-            &mut progress,
-        )?;
-        Ok(seconds_to_t0)
-    })
-    .with_context(|| format!("recording case {}", plan.case_path.display()))?;
-    let seconds_recording_run = started.elapsed().as_secs_f64();
-    bar.finish_and_clear();
-
-    let bar = super::runs_bar(plan.json, runs.len(), "extrapolate+compare");
-    let mut grid = Vec::new();
-    for ((o, stem), (rec, extra)) in runs.iter().zip(&stems).zip(&paths) {
-        bar.set_message(stem.clone());
-        let outcome = evaluate(rec, extra, periods, plan.threads, plan.cells)?;
-        grid.push(Entry {
-            n: o.sample_every,
-            dtc_max_steps: o.dtc_max_steps,
-            outcome,
-        });
-        bar.inc(1);
-    }
-    bar.finish_and_clear();
-
+    let (seconds_to_t0, seconds_recording_run) = record_grid(plan, runs, &paths)?;
+    let grid = evaluate_grid(plan, runs, &stems, &paths, periods)?;
     let study = SamplingStudy {
         study: "sampling",
         case: plan.case_path.display().to_string(),
@@ -138,7 +99,77 @@ pub fn run(
             .collect(),
         grid,
     };
-    let mut svgs: Vec<(&str, String)> = Vec::new();
+    let svgs = svgs(&study)?;
+    let table = table(&study);
+    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
+}
+
+/// Records every combination of `runs` from one DEM run into `paths` (each's recording);
+/// returns the seconds to t0 and of the whole recording run.
+fn record_grid(
+    plan: &StudyPlan,
+    runs: &[RecordOptions],
+    paths: &[(PathBuf, PathBuf)],
+) -> Result<(f64, f64)> {
+    let bar = super::dem_bar(plan.json, "study");
+    let started = Instant::now();
+    let seconds_to_t0 = crate::with_workers(plan.threads, || {
+        let mut progress = super::on_phase_logged(&bar);
+        let mut sim = record::run_to_t0(&plan.case, &mut progress)?;
+        let seconds_to_t0 = started.elapsed().as_secs_f64();
+        let jobs: Vec<RecordJob> = runs
+            .iter()
+            .zip(paths)
+            .map(|(o, (rec, _))| RecordJob {
+                options: o.clone(),
+                dest: rec,
+            })
+            .collect();
+        record::record_many_from_t0(
+            &mut sim,
+            &plan.case_path,
+            &plan.case_toml,
+            &jobs,
+            seconds_to_t0,
+            &mut progress,
+        )?;
+        Ok(seconds_to_t0)
+    })
+    .with_context(|| format!("recording case {}", plan.case_path.display()))?;
+    let seconds_recording_run = started.elapsed().as_secs_f64();
+    bar.finish_and_clear();
+
+    Ok((seconds_to_t0, seconds_recording_run))
+}
+
+/// Extrapolates and compares each combination's recording over `periods` reference periods.
+fn evaluate_grid(
+    plan: &StudyPlan,
+    runs: &[RecordOptions],
+    stems: &[String],
+    paths: &[(PathBuf, PathBuf)],
+    periods: u32,
+) -> Result<Vec<Entry>> {
+    let bar = super::runs_bar(plan.json, runs.len(), "extrapolate+compare");
+    let mut grid = Vec::new();
+    for ((o, stem), (rec, extra)) in runs.iter().zip(stems).zip(paths) {
+        bar.set_message(stem.clone());
+        let outcome = evaluate(rec, extra, periods, plan.threads, plan.cells)?;
+        grid.push(Entry {
+            n: o.sample_every,
+            dtc_max_steps: o.dtc_max_steps,
+            outcome,
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+
+    Ok(grid)
+}
+
+/// The study's plots: the largest ε_rel against the table's size and against the speedup.
+fn svgs(study: &SamplingStudy) -> Result<Vec<(&'static str, String)>> {
+    let mut svgs: Vec<(&'static str, String)> = Vec::new();
     let label = |e: &Entry| format!("n{}/{}", e.n, e.dtc_max_steps);
     let size: Vec<(f64, f64, String)> = study
         .grid
@@ -183,8 +214,7 @@ pub fn run(
             &speed,
         )?,
     ));
-    let table = table(&study);
-    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
+    Ok(svgs)
 }
 
 fn table(s: &SamplingStudy) -> String {
