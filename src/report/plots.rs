@@ -826,150 +826,168 @@ pub fn errors(c: &Comparison) -> Result<String> {
         let panels = root.split_evenly((rows as usize, 1));
         let ks: Vec<f64> = c.periods.iter().map(|p| p.k as f64).collect();
         let x = span(ks.iter().copied(), &[], 0.0);
-        let x = x.start - 0.5..x.end + 0.5;
-        let n_labels = ks.len().clamp(2, 12);
-        // `(k, f(period))` where `f` has a value
-        let by_k = |f: fn(&PeriodComparison) -> Option<f64>| -> Line {
-            c.periods
-                .iter()
-                .filter_map(|p| Some((p.k as f64, f(p)?)))
-                .collect()
+        let axis = KAxis {
+            x: x.start - 0.5..x.end + 0.5,
+            n_labels: ks.len().clamp(2, 12),
         };
-
-        // ε_abs and the floor
-        let abs = by_k(|p| Some(p.eps_abs));
-        let to_runs = by_k(|p| p.eps_abs_to_dem_runs);
-        // with two DEM runs there is one distance between them, no range: the band is then
-        // from 0 up to that distance (a point above it is a ratio above 1 there, which the
-        // verdict allows at some t_k: with one twin its median decides)
-        let one_pair = c.dem_runs == 2;
-        let band: Vec<(f64, f64, f64)> = c
-            .periods
-            .iter()
-            .filter_map(|p| {
-                let low = if one_pair { 0.0 } else { p.floor_eps_abs_min? };
-                Some((p.k as f64, low, p.floor_eps_abs_max?))
-            })
-            .collect();
-        let floor_mean = by_k(|p| p.floor_eps_abs);
-        let y = span(
-            abs.iter()
-                .chain(&to_runs)
-                .map(|q| q.1)
-                .chain(band.iter().flat_map(|b| [b.1, b.2])),
-            &[0.0],
-            0.1,
-        );
-        let mut top = k_panel(
-            &panels[0],
-            "Absolute error over the Voronoi cells",
-            x.clone(),
-            y,
-            "ε_abs (K)",
-            n_labels,
-        )?;
-        if !band.is_empty() {
-            // one k alone is drawn as a bar a third of a step wide
-            let w = if band.len() == 1 { 0.15 } else { 0.0 };
-            let mut poly: Vec<(f64, f64)> = Vec::new();
-            if let (Some(first), Some(last)) = (band.first(), band.last()) {
-                poly.push((first.0 - w, first.1));
-                poly.extend(band.iter().map(|b| (b.0, b.1)));
-                poly.push((last.0 + w, last.1));
-                poly.push((last.0 + w, last.2));
-                poly.extend(band.iter().rev().map(|b| (b.0, b.2)));
-                poly.push((first.0 - w, first.2));
-            }
-            let label = if one_pair {
-                "within the floor: up to ε_abs between the 2 DEM runs".to_string()
-            } else {
-                format!("floor: ε_abs between the {} DEM runs, min–max", c.dem_runs)
-            };
-            filled(&mut top, poly, DEM.mix(0.2), label)?;
-            dashed_line(
-                &mut top,
-                floor_mean.clone(),
-                DEM,
-                Some("floor, mean".into()),
-            )?;
-        }
-        line(
-            &mut top,
-            &abs,
-            Kind::Dem,
-            BLACK,
-            Some("extrapolated to the DEM reference".into()),
-        )?;
-        line(
-            &mut top,
-            &to_runs,
-            Kind::Extrapolated,
-            HOT,
-            Some("extrapolated to the DEM runs, mean".into()),
-        )?;
-        let (lows, highs): (Line, Line) = band.iter().map(|b| ((b.0, b.1), (b.0, b.2))).unzip();
-        legend(&mut top, &[&abs, &to_runs, &lows, &highs, &floor_mean])?;
-
-        // ε_rel and Eq. 10
-        let rel = by_k(|p| Some(100.0 * p.eps_rel?));
-        let floor_rel = by_k(|p| Some(100.0 * p.floor_eps_rel?));
-        let energy = by_k(|p| Some(100.0 * p.energy_error?));
-        let y = value_span(&[&rel, &energy, &floor_rel], &[0.0], 0.1);
-        let mut mid = k_panel(
-            &panels[1],
-            "Relative and energy-transfer errors",
-            x.clone(),
-            y,
-            "error (%)",
-            n_labels,
-        )?;
-        if rel.is_empty() && energy.is_empty() {
-            message(&panels[1], "ε_rel and the Eq. 10 error are undefined here")?;
-        } else {
-            line(
-                &mut mid,
-                &rel,
-                Kind::Dem,
-                HOT,
-                Some(format!("ε_rel = ε_abs / {}", contrast_label(c))),
-            )?;
-            if !floor_rel.is_empty() {
-                let label = "floor ε_rel (mean between DEM runs)";
-                dashed_line(&mut mid, floor_rel.clone(), DEM, Some(label.into()))?;
-            }
-            if !energy.is_empty() {
-                mid.draw_series(DashedLineSeries::new(
-                    energy.clone(),
-                    8,
-                    5,
-                    COLD.stroke_width(2),
-                ))?
-                .label("Eq. 10 energy-transfer error")
-                .legend(dashed(COLD));
-                mid.draw_series(
-                    energy
-                        .iter()
-                        .map(|&p| TriangleMarker::new(p, 6, COLD.filled())),
-                )?;
-            }
-            legend(&mut mid, &[&rel, &floor_rel, &energy])?;
-        }
-
+        absolute_errors(&panels[0], c, &axis)?;
+        relative_errors(&panels[1], c, &axis)?;
         if has_contrast {
-            let contrast = by_k(|p| p.contrast);
+            let contrast = by_k(c, |p| p.contrast);
             let y = value_span(&[&contrast], &[0.0], 0.1);
             let mut bottom = k_panel(
                 &panels[2],
                 &format!("What ε_rel divides by: {}", contrast_label(c)),
-                x,
+                axis.x,
                 y,
                 "contrast (K)",
-                n_labels,
+                axis.n_labels,
             )?;
             line(&mut bottom, &contrast, Kind::Dem, GREY, None)?;
         }
         Ok(())
     })
+}
+
+/// The compared `t_k` as the errors' panels share them: their span and how many labels.
+struct KAxis {
+    x: Range<f64>,
+    n_labels: usize,
+}
+
+/// `(k, f(period))` of the compared periods where `f` has a value.
+fn by_k(c: &Comparison, f: fn(&PeriodComparison) -> Option<f64>) -> Line {
+    c.periods
+        .iter()
+        .filter_map(|p| Some((p.k as f64, f(p)?)))
+        .collect()
+}
+
+/// ε_abs to the reference and to the DEM runs, with the DEM runs' own spread as a band.
+fn absolute_errors(area: &Area, c: &Comparison, axis: &KAxis) -> Result<()> {
+    let abs = by_k(c, |p| Some(p.eps_abs));
+    let to_runs = by_k(c, |p| p.eps_abs_to_dem_runs);
+    // with two DEM runs there is one distance between them, no range: the band is then
+    // from 0 up to that distance (a point above it is a ratio above 1 there, which the
+    // verdict allows at some t_k: with one twin its median decides)
+    let one_pair = c.dem_runs == 2;
+    let band: Vec<(f64, f64, f64)> = c
+        .periods
+        .iter()
+        .filter_map(|p| {
+            let low = if one_pair { 0.0 } else { p.floor_eps_abs_min? };
+            Some((p.k as f64, low, p.floor_eps_abs_max?))
+        })
+        .collect();
+    let floor_mean = by_k(c, |p| p.floor_eps_abs);
+    let y = span(
+        abs.iter()
+            .chain(&to_runs)
+            .map(|q| q.1)
+            .chain(band.iter().flat_map(|b| [b.1, b.2])),
+        &[0.0],
+        0.1,
+    );
+    let mut top = k_panel(
+        area,
+        "Absolute error over the Voronoi cells",
+        axis.x.clone(),
+        y,
+        "ε_abs (K)",
+        axis.n_labels,
+    )?;
+    if !band.is_empty() {
+        // one k alone is drawn as a bar a third of a step wide
+        let w = if band.len() == 1 { 0.15 } else { 0.0 };
+        let mut poly: Vec<(f64, f64)> = Vec::new();
+        if let (Some(first), Some(last)) = (band.first(), band.last()) {
+            poly.push((first.0 - w, first.1));
+            poly.extend(band.iter().map(|b| (b.0, b.1)));
+            poly.push((last.0 + w, last.1));
+            poly.push((last.0 + w, last.2));
+            poly.extend(band.iter().rev().map(|b| (b.0, b.2)));
+            poly.push((first.0 - w, first.2));
+        }
+        let label = if one_pair {
+            "within the floor: up to ε_abs between the 2 DEM runs".to_string()
+        } else {
+            format!("floor: ε_abs between the {} DEM runs, min–max", c.dem_runs)
+        };
+        filled(&mut top, poly, DEM.mix(0.2), label)?;
+        dashed_line(
+            &mut top,
+            floor_mean.clone(),
+            DEM,
+            Some("floor, mean".into()),
+        )?;
+    }
+    line(
+        &mut top,
+        &abs,
+        Kind::Dem,
+        BLACK,
+        Some("extrapolated to the DEM reference".into()),
+    )?;
+    line(
+        &mut top,
+        &to_runs,
+        Kind::Extrapolated,
+        HOT,
+        Some("extrapolated to the DEM runs, mean".into()),
+    )?;
+    let (lows, highs): (Line, Line) = band.iter().map(|b| ((b.0, b.1), (b.0, b.2))).unzip();
+    legend(&mut top, &[&abs, &to_runs, &lows, &highs, &floor_mean])?;
+
+    Ok(())
+}
+
+/// ε_rel and the Eq. 10 energy-transfer error, with the floor's ε_rel.
+fn relative_errors(area: &Area, c: &Comparison, axis: &KAxis) -> Result<()> {
+    let rel = by_k(c, |p| Some(100.0 * p.eps_rel?));
+    let floor_rel = by_k(c, |p| Some(100.0 * p.floor_eps_rel?));
+    let energy = by_k(c, |p| Some(100.0 * p.energy_error?));
+    let y = value_span(&[&rel, &energy, &floor_rel], &[0.0], 0.1);
+    let mut mid = k_panel(
+        area,
+        "Relative and energy-transfer errors",
+        axis.x.clone(),
+        y,
+        "error (%)",
+        axis.n_labels,
+    )?;
+    if rel.is_empty() && energy.is_empty() {
+        message(area, "ε_rel and the Eq. 10 error are undefined here")?;
+    } else {
+        line(
+            &mut mid,
+            &rel,
+            Kind::Dem,
+            HOT,
+            Some(format!("ε_rel = ε_abs / {}", contrast_label(c))),
+        )?;
+        if !floor_rel.is_empty() {
+            let label = "floor ε_rel (mean between DEM runs)";
+            dashed_line(&mut mid, floor_rel.clone(), DEM, Some(label.into()))?;
+        }
+        if !energy.is_empty() {
+            mid.draw_series(DashedLineSeries::new(
+                energy.clone(),
+                8,
+                5,
+                COLD.stroke_width(2),
+            ))?
+            .label("Eq. 10 energy-transfer error")
+            .legend(dashed(COLD));
+            mid.draw_series(
+                energy
+                    .iter()
+                    .map(|&p| TriangleMarker::new(p, 6, COLD.filled())),
+            )?;
+        }
+        legend(&mut mid, &[&rel, &floor_rel, &energy])?;
+    }
+
+    Ok(())
 }
 
 /// ε_rel at every compared `t_k` against the speedup of reaching `t_k` (ε_abs in K when
