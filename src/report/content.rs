@@ -313,22 +313,33 @@ pub fn document(inp: &Inputs) -> Document {
 /// What was extrapolated: the files, the case, the recording's settings and the
 /// extrapolation's.
 fn extrapolated_section(d: &mut Document, inp: &Inputs) {
+    d.push(Block::Heading(2, "What was extrapolated".into()));
+    let mut rows = recording_rows(inp);
+    rows.extend(extrapolation_rows(inp));
+    rows.push(row("tdex version", inp.info.tool_version.clone()));
+    d.push(Block::Table {
+        header: vec!["Quantity".into(), "Value".into()],
+        rows,
+        numeric: false,
+    });
+}
+
+/// `t_2 … t_last`, or none.
+fn span_to(last: u32) -> String {
+    if last >= 2 {
+        format!("t_2 … t_{last}")
+    } else {
+        "none".into()
+    }
+}
+
+/// The rows of the recording: its files, case, particles, sampling, period, reference and
+/// walls.
+fn recording_rows(inp: &Inputs) -> Vec<Vec<String>> {
     let info = inp.info;
-    let c = inp.comparison;
     let p = inp.prediction;
     let case = case_name(info);
-    // What was extrapolated.
-    d.push(Block::Heading(2, "What was extrapolated".into()));
     let n_steps = info.sample_every;
-    let periods = inp.extrapolation.periods;
-    let span = |last: u32| {
-        if last >= 2 {
-            format!("t_2 … t_{last}")
-        } else {
-            "none".into()
-        }
-    };
-    let pairing_row = roles_row(inp);
     let groups = if p.hot_particles + p.cold_particles > 0 {
         format!(
             "{} ({} initially hot, {} initially cold)",
@@ -337,117 +348,123 @@ fn extrapolated_section(d: &mut Document, inp: &Inputs) {
     } else {
         format!("{} (uniform initial temperature)", info.particles)
     };
-    d.push(Block::Table {
-        header: vec!["Quantity".into(), "Value".into()],
-        rows: vec![
-            row("Recording", inp.recording_path.clone()),
-            row("Extrapolation", inp.extrapolation_path.clone()),
-            row(
-                "Case",
-                if info.case_path.is_empty() {
-                    case.clone()
-                } else {
-                    format!("{case} ({})", info.case_path)
-                },
+    vec![
+        row("Recording", inp.recording_path.clone()),
+        row("Extrapolation", inp.extrapolation_path.clone()),
+        row(
+            "Case",
+            if info.case_path.is_empty() {
+                case.clone()
+            } else {
+                format!("{case} ({})", info.case_path)
+            },
+        ),
+        row("Particles", groups),
+        row("DEM time step Δt", format!("{} s", short(info.dt))),
+        row(
+            "Sampling n",
+            format!("{n_steps} steps ({} s)", short(n_steps as f64 * info.dt)),
+        ),
+        row(
+            "Δt_c^max",
+            format!(
+                "{} steps ({} s)",
+                info.dtc_max_steps,
+                short(info.dtc_max_steps as f64 * info.dt)
             ),
-            row("Particles", groups),
-            row("DEM time step Δt", format!("{} s", short(info.dt))),
-            row(
-                "Sampling n",
-                format!("{n_steps} steps ({} s)", short(n_steps as f64 * info.dt)),
+        ),
+        row(
+            "Period τ",
+            format!("{} s ({} steps)", short(info.tau), info.period_steps),
+        ),
+        row(
+            "t0, t1",
+            format!(
+                "{} s, {} s",
+                short(info.snapshot_time(0)),
+                short(info.snapshot_time(1))
             ),
-            row(
-                "Δt_c^max",
+        ),
+        row(
+            "DEM reference",
+            if info.reference_periods == 0 {
+                "none (recorded without --reference)".into()
+            } else {
                 format!(
-                    "{} steps ({} s)",
-                    info.dtc_max_steps,
-                    short(info.dtc_max_steps as f64 * info.dt)
-                ),
-            ),
-            row(
-                "Period τ",
-                format!("{} s ({} steps)", short(info.tau), info.period_steps),
-            ),
-            row(
-                "t0, t1",
-                format!(
-                    "{} s, {} s",
-                    short(info.snapshot_time(0)),
-                    short(info.snapshot_time(1))
-                ),
-            ),
-            row(
-                "DEM reference",
-                if info.reference_periods == 0 {
-                    "none (recorded without --reference)".into()
-                } else {
-                    format!(
-                        "{} periods after t1 ({}){}",
-                        info.reference_periods,
-                        span(info.reference_periods + 1),
-                        match info.twins {
-                            0 => String::new(),
-                            1 => ", and 1 DEM twin".into(),
-                            m => format!(", and {m} DEM twins"),
-                        }
-                    )
-                },
-            ),
-            row(
-                "Walls",
-                match p.wall_temperature {
-                    Some(w) => format!("conducting, held at {} K", short(w)),
-                    None => "adiabatic".into(),
-                },
-            ),
-            row(
-                "Extrapolation scheme",
-                inp.extrapolation.scheme.name().into(),
-            ),
-            row(
-                "Extrapolated periods",
-                format!("{periods} ({})", span(periods + 1)),
-            ),
-            pairing_row,
-        ]
-        .into_iter()
-        // with the mirror, whether the bed was its own mirror image: how far to trust it
-        .chain((!inp.extrapolation.mirror_check.is_empty()).then(|| {
-            row(
-                "Mirror check",
-                crate::extrapolation::mirror_check_lines(&inp.extrapolation.mirror_check)
-                    .join("; "),
-            )
-        }))
-        // with fresh boundary maps, what each jump drew from
-        .chain((!inp.extrapolation.boundary.is_exact()).then(|| {
-            row(
-                "Boundary maps",
-                crate::extrapolation::boundary_lines(
-                    inp.extrapolation.boundary,
-                    &inp.extrapolation.fresh_pools,
+                    "{} periods after t1 ({}){}",
+                    info.reference_periods,
+                    span_to(info.reference_periods + 1),
+                    match info.twins {
+                        0 => String::new(),
+                        1 => ", and 1 DEM twin".into(),
+                        m => format!(", and {m} DEM twins"),
+                    }
                 )
-                .join("; "),
+            },
+        ),
+        row(
+            "Walls",
+            match p.wall_temperature {
+                Some(w) => format!("conducting, held at {} K", short(w)),
+                None => "adiabatic".into(),
+            },
+        ),
+    ]
+}
+
+/// The rows of the extrapolation: its scheme, periods, roles, mirror check, boundary maps
+/// and the comparison's cells.
+fn extrapolation_rows(inp: &Inputs) -> Vec<Vec<String>> {
+    let (info, p, periods) = (inp.info, inp.prediction, inp.extrapolation.periods);
+    let mut rows = vec![
+        row(
+            "Extrapolation scheme",
+            inp.extrapolation.scheme.name().into(),
+        ),
+        row(
+            "Extrapolated periods",
+            format!("{periods} ({})", span_to(periods + 1)),
+        ),
+        roles_row(inp),
+    ];
+    // with the mirror, whether the bed was its own mirror image: how far to trust it
+    if !inp.extrapolation.mirror_check.is_empty() {
+        rows.push(row(
+            "Mirror check",
+            crate::extrapolation::mirror_check_lines(&inp.extrapolation.mirror_check).join("; "),
+        ));
+    }
+    // with fresh boundary maps, what each jump drew from
+    if !inp.extrapolation.boundary.is_exact() {
+        rows.push(row(
+            "Boundary maps",
+            crate::extrapolation::boundary_lines(
+                inp.extrapolation.boundary,
+                &inp.extrapolation.fresh_pools,
             )
-        }))
-        .chain(c.map(|c| row("Voronoi cells", format!("{} (seed {})", c.cells, c.seed))))
-        .chain(p.lacey_cells.map(|n| {
-            row(
-                "Voronoi cells of the Lacey index",
-                format!(
-                    "{n} (about {} particles each)",
-                    short(
-                        sig(info.particles as f64 / n as f64, 3)
-                            .parse()
-                            .unwrap_or(0.0)
-                    )
-                ),
-            )
-        }))
-        .chain([row("tdex version", info.tool_version.clone())])
-        .collect(),
-        numeric: false,
-    });
+            .join("; "),
+        ));
+    }
+    if let Some(c) = inp.comparison {
+        rows.push(row(
+            "Voronoi cells",
+            format!("{} (seed {})", c.cells, c.seed),
+        ));
+    }
+    if let Some(n) = p.lacey_cells {
+        rows.push(row(
+            "Voronoi cells of the Lacey index",
+            format!(
+                "{n} (about {} particles each)",
+                short(
+                    sig(info.particles as f64 / n as f64, 3)
+                        .parse()
+                        .unwrap_or(0.0)
+                )
+            ),
+        ));
+    }
+    rows
 }
 
 /// The table's row of the roles: the pairing, or the path through several recorded periods.
