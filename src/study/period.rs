@@ -5,7 +5,9 @@
 use super::{evaluate, plots, run_paths, Outcome};
 use crate::cli::StudyPlan;
 use anyhow::{Context, Result};
+use indicatif::ProgressBar;
 use recorder::record::{self, RecordOptions};
+use recorder::Simulation;
 use serde::Serialize;
 use std::time::Instant;
 
@@ -31,13 +33,11 @@ struct PeriodStudy {
 }
 
 pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) -> Result<()> {
-    let dir = &plan.output;
     let say = |s: String| {
         if !plan.json {
             println!("{s}");
         }
     };
-    let dt = plan.case.time.dt;
     say(format!(
         "record        {} periods τ, each over {revolutions} revolutions of DEM reference, from one \
          state at t0",
@@ -53,6 +53,32 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
     })
     .with_context(|| format!("running case {} to t0", plan.case_path.display()))?;
     let seconds_to_t0 = started.elapsed().as_secs_f64();
+    let entries = record_and_evaluate(plan, runs, &sim0, seconds_to_t0, &bar)?;
+    bar.finish_and_clear();
+    let study = PeriodStudy {
+        study: "period",
+        case: plan.case_path.display().to_string(),
+        particles: plan.case.particles.count,
+        revolutions,
+        rotation_period: plan.case.drum.rotation_period,
+        seconds_to_t0,
+        runs: entries,
+    };
+    let svgs = svgs(&study)?;
+    let table = table(&study);
+    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
+}
+
+/// Records each τ of `runs` from the state at t0 (`sim0`, reached in `seconds_to_t0`),
+/// then extrapolates and compares it.
+fn record_and_evaluate(
+    plan: &StudyPlan,
+    runs: &[(f64, RecordOptions)],
+    sim0: &Simulation,
+    seconds_to_t0: f64,
+    bar: &ProgressBar,
+) -> Result<Vec<Entry>> {
+    let (dir, dt) = (&plan.output, plan.case.time.dt);
     let mut entries = Vec::new();
     for (f, o) in runs {
         let stem = format!("tau{f}rev");
@@ -66,7 +92,7 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
                 o,
                 &rec,
                 seconds_to_t0,
-                &mut super::on_phase_logged(&bar),
+                &mut super::on_phase_logged(bar),
             )?)
         })
         .with_context(|| format!("recording τ = {f} revolution"))?;
@@ -80,17 +106,13 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
             outcome,
         });
     }
-    bar.finish_and_clear();
-    let study = PeriodStudy {
-        study: "period",
-        case: plan.case_path.display().to_string(),
-        particles: plan.case.particles.count,
-        revolutions,
-        rotation_period: plan.case.drum.rotation_period,
-        seconds_to_t0,
-        runs: entries,
-    };
-    let mut svgs: Vec<(&str, String)> = Vec::new();
+    Ok(entries)
+}
+
+/// The study's plots: the largest ε_rel against the speedup per τ, and the group means of
+/// each τ's extrapolation beside the DEM's.
+fn svgs(study: &PeriodStudy) -> Result<Vec<(&'static str, String)>> {
+    let mut svgs: Vec<(&'static str, String)> = Vec::new();
     let points: Vec<(f64, f64, String)> = study
         .runs
         .iter()
@@ -151,8 +173,7 @@ pub fn run(plan: &StudyPlan, runs: &[(f64, RecordOptions)], revolutions: f64) ->
         "means.svg",
         plots::means("Hot and cold group means per pairing period", &series)?,
     ));
-    let table = table(&study);
-    super::finish(plan, &study, &table, &markdown(&study, &table), svgs)
+    Ok(svgs)
 }
 
 fn table(s: &PeriodStudy) -> String {
