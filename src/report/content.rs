@@ -530,6 +530,13 @@ fn prediction_section(d: &mut Document, inp: &Inputs) {
          over the bed's volume.{with_dem}",
         p.periods()
     ))]));
+    d.push(prediction_table(p));
+    prediction_figures(d, inp);
+}
+
+/// The prediction at t1, a middle and the last t_k: the means, the spread, the mixing and
+/// the walls' heat.
+fn prediction_table(p: &Prediction) -> Block {
     let shown: Vec<&Point> = {
         let mut v: Vec<&Point> = Vec::new();
         for q in [p.first(), &p.points[p.points.len() / 2], p.last()] {
@@ -581,11 +588,16 @@ fn prediction_section(d: &mut Document, inp: &Inputs) {
             sig(q.heat - t1_heat, 4)
         }));
     }
-    d.push(Block::Table {
+    Block::Table {
         header,
         rows,
         numeric: true,
-    });
+    }
+}
+
+/// The prediction's figures over time, those the report drew.
+fn prediction_figures(d: &mut Document, inp: &Inputs) {
+    let p = inp.prediction;
     figure(
         d,
         "The bed mean over time: ",
