@@ -708,6 +708,37 @@ fn print_human(s: &Inspection) {
         "collisions    {} (durations: samples seen → steps)",
         s.collisions
     );
+    print_durations(s);
+    println!("suggested n   {}", suggested_n_line(s));
+    if let Some(h) = &s.recorded_wall_heat {
+        println!(
+            "wall heat     over the recorded period: {} J in the DEM, {} J from its table replayed from t0 ({:+.2} %)",
+            fmt::sig(h.dem, 6),
+            fmt::sig(h.replayed, 6),
+            100.0 * h.relative_difference
+        );
+    }
+    if let Some(w) = &s.max_cfl {
+        println!(
+            "max CFL c     {:.4} (row {}: bodies {} and {}, m = {} steps, sqrt(a) = {:.4e} m){}",
+            w.cfl,
+            w.row,
+            w.i,
+            w.j,
+            w.duration_steps,
+            w.sqrt_area,
+            if w.cfl >= 1.0 {
+                " — the explicit replay will refuse this table"
+            } else {
+                ""
+            }
+        );
+    }
+    print_snapshots_and_costs(s);
+}
+
+/// The collisions' durations, bin by bin up to the shown bins, then the rest in one line.
+fn print_durations(s: &Inspection) {
     let total = s.collisions.max(1) as f64;
     let mut cumulative = 0u64;
     let (shown, tail) = s
@@ -737,31 +768,10 @@ fn print_human(s: &Inspection) {
             100.0 * count as f64 / total
         );
     }
-    println!("suggested n   {}", suggested_n_line(s));
-    if let Some(h) = &s.recorded_wall_heat {
-        println!(
-            "wall heat     over the recorded period: {} J in the DEM, {} J from its table replayed from t0 ({:+.2} %)",
-            fmt::sig(h.dem, 6),
-            fmt::sig(h.replayed, 6),
-            100.0 * h.relative_difference
-        );
-    }
-    if let Some(w) = &s.max_cfl {
-        println!(
-            "max CFL c     {:.4} (row {}: bodies {} and {}, m = {} steps, sqrt(a) = {:.4e} m){}",
-            w.cfl,
-            w.row,
-            w.i,
-            w.j,
-            w.duration_steps,
-            w.sqrt_area,
-            if w.cfl >= 1.0 {
-                " — the explicit replay will refuse this table"
-            } else {
-                ""
-            }
-        );
-    }
+}
+
+/// Each snapshot's time, mean temperature and mean position, then the recording's costs.
+fn print_snapshots_and_costs(s: &Inspection) {
     for snap in &s.snapshots {
         println!(
             "snapshot {:>3}  t = {}, mean T {:.6} K, mean position [{:.5}, {:.5}, {:.5}] m",
