@@ -252,7 +252,7 @@ impl DemRuns {
         second_groups: &HotCold,
         within_recording: bool,
     ) -> Result<PeriodComparison> {
-        let (k_before, k) = (dem_before.index, dem_after.index);
+        let k = dem_after.index;
         // the DEM runs at t_k: the reference, then every further run that reached t_k
         let (at_k, at_k_groups): (Vec<&Snapshot>, Vec<&HotCold>) = self
             .others
@@ -295,25 +295,7 @@ impl DemRuns {
                 self.departure,
             )
         });
-        // Eq. 10 of each further run against the reference over t_{k-1} -> t_k; a twin
-        // has no snapshot at t1, where it is the reference
-        let floor_energy_error = self
-            .others
-            .iter()
-            .filter_map(|o| {
-                let twin_after = o.iter().find(|s| s.index == k)?;
-                let twin_before = o
-                    .iter()
-                    .find(|s| s.index == k_before)
-                    .map_or(&dem_before.temp, |s| &s.temp);
-                metrics::energy_error(
-                    &dem_before.temp,
-                    &dem_after.temp,
-                    twin_before,
-                    &twin_after.temp,
-                )
-            })
-            .max_by(|a, b| a.abs().total_cmp(&b.abs()));
+        let floor_energy_error = self.floor_energy_error(dem_before, dem_after);
         Ok(PeriodComparison {
             k,
             t: after.time,
@@ -360,5 +342,28 @@ impl DemRuns {
             pattern,
             within_recording,
         })
+    }
+
+    /// The largest Eq. 10 error of a further DEM run against the reference over
+    /// `dem_before` → `dem_after` (t_{k−1} → t_k): the energy error's floor. A twin has no
+    /// snapshot at t1, where it is the reference.
+    fn floor_energy_error(&self, dem_before: &Snapshot, dem_after: &Snapshot) -> Option<f64> {
+        let (k_before, k) = (dem_before.index, dem_after.index);
+        self.others
+            .iter()
+            .filter_map(|o| {
+                let twin_after = o.iter().find(|s| s.index == k)?;
+                let twin_before = o
+                    .iter()
+                    .find(|s| s.index == k_before)
+                    .map_or(&dem_before.temp, |s| &s.temp);
+                metrics::energy_error(
+                    &dem_before.temp,
+                    &dem_after.temp,
+                    twin_before,
+                    &twin_after.temp,
+                )
+            })
+            .max_by(|a, b| a.abs().total_cmp(&b.abs()))
     }
 }
