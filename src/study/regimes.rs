@@ -7,6 +7,7 @@ use super::flow::{self, Regime};
 use super::{evaluate, num, pct, plots, run_paths, write_file, Outcome};
 use crate::cli::{RegimeRun, StudyPlan};
 use anyhow::{Context, Result};
+use indicatif::ProgressBar;
 use recorder::record;
 use serde::Serialize;
 use std::time::Instant;
@@ -74,89 +75,101 @@ fn refusal(
     }
 }
 
-pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64) -> Result<()> {
+/// Records one speed of the study, measures its flow at t1 and, unless the method is refused
+/// there (a centrifuging drum, or particles moving relative to the drum at less than
+/// `min_relative` of ωR), extrapolates and compares it.
+fn run_speed(
+    plan: &StudyPlan,
+    r: &RegimeRun,
+    min_relative: f64,
+    bar: &ProgressBar,
+) -> Result<Entry> {
     let dir = &plan.output;
-    let bar = super::dem_bar(plan.json, "study");
-    let mut entries = Vec::new();
-    for r in runs {
-        let stem = format!("rev{}s", r.rotation_period);
-        let (rec, extra) = run_paths(dir, &stem);
-        let case_path = dir.join(format!("{stem}.toml"));
-        write_file(dir, &format!("{stem}.toml"), &r.case_toml)?;
-        let omega = r.case.angular_velocity();
-        let fr = flow::froude(&r.case);
-        if !plan.json {
-            bar.suspend(|| {
-                println!(
-                    "speed         {} s per revolution: ω = {omega:.4} rad/s, Froude {fr:.4e} ({})",
-                    r.rotation_period,
-                    flow::regime(fr).name()
-                )
-            });
-        }
-        let started = Instant::now();
-        crate::with_workers(plan.threads, || {
-            let mut progress = super::on_phase_logged(&bar);
-            let mut sim = record::run_to_t0(&r.case, &mut progress)?;
-            let seconds_to_t0 = started.elapsed().as_secs_f64();
-            Ok(record::record_from_t0(
-                &mut sim,
-                &case_path,
-                &r.case_toml,
-                &r.options,
-                &rec,
-                seconds_to_t0,
-                &mut progress,
-            )?)
-        })
-        .with_context(|| format!("recording {} s per revolution", r.rotation_period))?;
-        bar.set_message("");
-        let reader = RecordingReader::open(&rec)?;
-        let t1 = reader
-            .snapshot(1)?
-            .with_context(|| format!("{}: no snapshot at t1", rec.display()))?;
-        let measured = flow::measure(&t1, omega, r.case.drum.radius);
-        let diameter = t1.mean_diameter();
-        let refused = refusal(
-            r.rotation_period,
-            omega,
-            fr,
-            measured.relative_speed,
-            min_relative,
-        );
-        let outcome = match &refused {
-            Some(_) => None,
-            None => Some(evaluate(
-                &rec,
-                &extra,
-                r.options.reference_periods,
-                plan.threads,
-                plan.cells,
-            )?),
-        };
-        if let Some(msg) = &refused {
-            if !plan.json {
-                bar.suspend(|| println!("refused       {msg}"));
-            }
-        }
-        let layer = measured.active_layer.as_ref();
-        entries.push(Entry {
-            rotation_period: r.rotation_period,
-            omega,
-            froude: fr,
-            regime: flow::regime(fr),
-            mellmann_candidates: flow::candidate_regimes(fr),
-            tau: r.options.period_steps as f64 * r.case.time.dt,
-            angle_degrees: measured.angle_degrees,
-            active_layer_m: layer.map(|l| l.thickness),
-            active_layer_diameters: layer.map(|l| l.thickness / diameter),
-            active_layer_whole_depth: layer.map(|l| l.whole_depth),
-            relative_speed: measured.relative_speed,
-            extrapolated: outcome.as_ref().is_some_and(|o| o.error.is_none()),
-            refusal: refused,
-            outcome,
+    let stem = format!("rev{}s", r.rotation_period);
+    let (rec, extra) = run_paths(dir, &stem);
+    let case_path = dir.join(format!("{stem}.toml"));
+    write_file(dir, &format!("{stem}.toml"), &r.case_toml)?;
+    let omega = r.case.angular_velocity();
+    let fr = flow::froude(&r.case);
+    if !plan.json {
+        bar.suspend(|| {
+            println!(
+                "speed         {} s per revolution: ω = {omega:.4} rad/s, Froude {fr:.4e} ({})",
+                r.rotation_period,
+                flow::regime(fr).name()
+            )
         });
     }
+    let started = Instant::now();
+    crate::with_workers(plan.threads, || {
+        let mut progress = super::on_phase_logged(bar);
+        let mut sim = record::run_to_t0(&r.case, &mut progress)?;
+        let seconds_to_t0 = started.elapsed().as_secs_f64();
+        Ok(record::record_from_t0(
+            &mut sim,
+            &case_path,
+            &r.case_toml,
+            &r.options,
+            &rec,
+            seconds_to_t0,
+            &mut progress,
+        )?)
+    })
+    .with_context(|| format!("recording {} s per revolution", r.rotation_period))?;
+    bar.set_message("");
+    let reader = RecordingReader::open(&rec)?;
+    let t1 = reader
+        .snapshot(1)?
+        .with_context(|| format!("{}: no snapshot at t1", rec.display()))?;
+    let measured = flow::measure(&t1, omega, r.case.drum.radius);
+    let diameter = t1.mean_diameter();
+    let refused = refusal(
+        r.rotation_period,
+        omega,
+        fr,
+        measured.relative_speed,
+        min_relative,
+    );
+    let outcome = match &refused {
+        Some(_) => None,
+        None => Some(evaluate(
+            &rec,
+            &extra,
+            r.options.reference_periods,
+            plan.threads,
+            plan.cells,
+        )?),
+    };
+    if let Some(msg) = &refused {
+        if !plan.json {
+            bar.suspend(|| println!("refused       {msg}"));
+        }
+    }
+    let layer = measured.active_layer.as_ref();
+    Ok(Entry {
+        rotation_period: r.rotation_period,
+        omega,
+        froude: fr,
+        regime: flow::regime(fr),
+        mellmann_candidates: flow::candidate_regimes(fr),
+        tau: r.options.period_steps as f64 * r.case.time.dt,
+        angle_degrees: measured.angle_degrees,
+        active_layer_m: layer.map(|l| l.thickness),
+        active_layer_diameters: layer.map(|l| l.thickness / diameter),
+        active_layer_whole_depth: layer.map(|l| l.whole_depth),
+        relative_speed: measured.relative_speed,
+        extrapolated: outcome.as_ref().is_some_and(|o| o.error.is_none()),
+        refusal: refused,
+        outcome,
+    })
+}
+
+pub fn run(plan: &StudyPlan, runs: &[RegimeRun], tau_rev: f64, min_relative: f64) -> Result<()> {
+    let bar = super::dem_bar(plan.json, "study");
+    let entries = runs
+        .iter()
+        .map(|r| run_speed(plan, r, min_relative, &bar))
+        .collect::<Result<Vec<_>>>()?;
     bar.finish_and_clear();
     let study = RegimesStudy {
         study: "regimes",
