@@ -316,8 +316,7 @@ impl<'a> Bed<'a> {
     /// once if the auction stopped on a graph without a perfect matching. Returns the
     /// solve and the number of slabs (1: none).
     fn warm_start(&self, allow_slabs: bool) -> (Solve, usize) {
-        let (t, n, opts, scale) = (self.t, self.n(), self.opts, self.scale);
-        let (x0, x1) = (&self.x0[..], &self.x1[..]);
+        let (t, n, scale, x0) = (self.t, self.n(), self.scale, &self.x0[..]);
         let Candidates {
             mut graph,
             mut k0,
@@ -347,67 +346,9 @@ impl<'a> Bed<'a> {
         let slab_count = cut.as_ref().map_or(1, slabs::Slabs::count);
         // The certificate's tree is built on the second core while the first runs the
         // sequential auction before the first search.
-        let build_tree = || opts.certify.then(|| self.new_tree());
-        let (mut lap, mut bids, tree) = if let Some(cut) = cut {
-            // The slabs stop where the certified path pauses (the global auction repairs
-            // the seams at that ε, then carries on as below).
-            let eps_slabs = (eps0 / AUCTION_REFINE).max(1);
-            let (mut lap, slab_bids) = slabs::warm_start(
-                &cut,
-                &self.axial,
-                &graph,
-                x0,
-                x1,
-                scale,
-                &v_axial,
-                [eps0, AUCTION_THETA, eps_slabs],
-                AUCTION_BIDS_PER_ROW,
-            );
-            trace!(
-                t,
-                "{} slabs: auction eps0 {eps0} -> {eps_slabs}: {slab_bids} bids, {} rows free",
-                cut.count(),
-                lap.free_rows()
-            );
-            let (seam_bids, tree) = rayon::join(
-                || {
-                    lap.auction(
-                        &graph,
-                        eps_slabs,
-                        AUCTION_THETA,
-                        self.eps_pause(eps0),
-                        budget,
-                    )
-                },
-                build_tree,
-            );
-            trace!(
-                t,
-                "seams: auction {eps_slabs} -> {}: {seam_bids} bids, {} rows free",
-                self.eps_pause(eps0),
-                lap.free_rows()
-            );
-            (lap, slab_bids + seam_bids, tree)
-        } else {
-            let mut lap = sparse_lap::Lap::new(n);
-            lap.set_potentials(&v_axial);
-            lap.greedy_init(&graph);
-            trace!(
-                t,
-                "axial potentials + row reduction: {} rows free",
-                lap.free_rows()
-            );
-            let (bids, tree) = rayon::join(
-                || lap.auction(&graph, eps0, AUCTION_THETA, self.eps_pause(eps0), budget),
-                build_tree,
-            );
-            trace!(
-                t,
-                "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
-                self.eps_pause(eps0),
-                lap.free_rows()
-            );
-            (lap, bids, tree)
+        let (mut lap, mut bids, tree) = match &cut {
+            Some(cut) => self.auction_on_slabs(cut, &graph, &v_axial, eps0),
+            None => self.auction_on_the_bed(&graph, &v_axial, eps0),
         };
         // An auction that stops on its budget may be bidding on a graph without a perfect
         // matching. If Hopcroft–Karp confirms that, k doubles once and the warm start is
@@ -443,6 +384,95 @@ impl<'a> Bed<'a> {
             examined: 0,
         };
         (solve, slab_count)
+    }
+
+    /// The warm start's auction on axial slabs of the bed, in parallel, from `eps0` to where
+    /// the certified path pauses (the global auction then repairs the seams at that ε);
+    /// returns the assignment, the bids and, when certifying, the certificate's tree (built
+    /// on the second core meanwhile).
+    fn auction_on_slabs(
+        &self,
+        cut: &slabs::Slabs,
+        graph: &candidates::Graph,
+        v_axial: &[i64],
+        eps0: i64,
+    ) -> (sparse_lap::Lap, u64, Option<certificate::WeightedTree>) {
+        let t = self.t;
+        let eps_slabs = (eps0 / AUCTION_REFINE).max(1);
+        let (mut lap, slab_bids) = slabs::warm_start(
+            cut,
+            &self.axial,
+            graph,
+            &self.x0,
+            &self.x1,
+            self.scale,
+            v_axial,
+            [eps0, AUCTION_THETA, eps_slabs],
+            AUCTION_BIDS_PER_ROW,
+        );
+        trace!(
+            t,
+            "{} slabs: auction eps0 {eps0} -> {eps_slabs}: {slab_bids} bids, {} rows free",
+            cut.count(),
+            lap.free_rows()
+        );
+        let (seam_bids, tree) = rayon::join(
+            || {
+                lap.auction(
+                    graph,
+                    eps_slabs,
+                    AUCTION_THETA,
+                    self.eps_pause(eps0),
+                    self.budget(),
+                )
+            },
+            || self.opts.certify.then(|| self.new_tree()),
+        );
+        trace!(
+            t,
+            "seams: auction {eps_slabs} -> {}: {seam_bids} bids, {} rows free",
+            self.eps_pause(eps0),
+            lap.free_rows()
+        );
+        (lap, slab_bids + seam_bids, tree)
+    }
+
+    /// The warm start's auction on the whole bed: the axial potentials and the row
+    /// reduction, then the auction from `eps0`; as [`Self::auction_on_slabs`] returns.
+    fn auction_on_the_bed(
+        &self,
+        graph: &candidates::Graph,
+        v_axial: &[i64],
+        eps0: i64,
+    ) -> (sparse_lap::Lap, u64, Option<certificate::WeightedTree>) {
+        let t = self.t;
+        let mut lap = sparse_lap::Lap::new(self.n());
+        lap.set_potentials(v_axial);
+        lap.greedy_init(graph);
+        trace!(
+            t,
+            "axial potentials + row reduction: {} rows free",
+            lap.free_rows()
+        );
+        let (bids, tree) = rayon::join(
+            || {
+                lap.auction(
+                    graph,
+                    eps0,
+                    AUCTION_THETA,
+                    self.eps_pause(eps0),
+                    self.budget(),
+                )
+            },
+            || self.opts.certify.then(|| self.new_tree()),
+        );
+        trace!(
+            t,
+            "auction eps0 {eps0} -> {}: {bids} bids, {} rows free",
+            self.eps_pause(eps0),
+            lap.free_rows()
+        );
+        (lap, bids, tree)
     }
 
     /// Certificate searches on the auction's near-optimal potentials (`AUCTION_ROUNDS`),
