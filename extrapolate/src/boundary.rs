@@ -149,10 +149,16 @@ pub enum Redraws {
     },
 }
 
+/// A cap zone (in diameters) asked of a section periodic along its axis, which has no caps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CapZoneWithoutCaps {
+    pub cap_zone_diameters: f64,
+}
+
 impl Redraws {
     /// What `maps` redraws in a recording whose axis ends as `axis`: `Ok(None)` for the
-    /// exact map, `Err(cap zone)` for a cap zone in a section periodic along the axis.
-    pub fn of(maps: BoundaryMaps, axis: AxialEnds) -> Result<Option<Self>, f64> {
+    /// exact map; a cap zone in a section periodic along the axis is refused.
+    pub fn of(maps: BoundaryMaps, axis: AxialEnds) -> Result<Option<Self>, CapZoneWithoutCaps> {
         Ok(match maps {
             BoundaryMaps::Exact => None,
             BoundaryMaps::FreshSteps {
@@ -181,7 +187,9 @@ impl Redraws {
                     AxialEnds::Periodic { length } if cap_zone_diameters == 0.0 => {
                         DriftEnds::Periodic { length }
                     }
-                    AxialEnds::Periodic { .. } => return Err(cap_zone_diameters),
+                    AxialEnds::Periodic { .. } => {
+                        return Err(CapZoneWithoutCaps { cap_zone_diameters })
+                    }
                 },
             }),
         })
@@ -864,7 +872,12 @@ mod tests {
             cap_zone_diameters,
         };
         let periodic = AxialEnds::Periodic { length: 30.0 };
-        assert_eq!(Redraws::of(drift(2.5), periodic), Err(2.5));
+        assert_eq!(
+            Redraws::of(drift(2.5), periodic),
+            Err(CapZoneWithoutCaps {
+                cap_zone_diameters: 2.5
+            })
+        );
         let planned = |maps, axis| match Redraws::of(maps, axis) {
             Ok(Some(Redraws::Drift { ends, .. })) => ends,
             other => panic!("{other:?}"),

@@ -114,9 +114,9 @@ impl<'a> Extrapolation<'a> {
             });
         }
         let redraws = Redraws::of(request.boundary, AxialEnds::of(axial_period(&info))).map_err(
-            |cap_zone_diameters| ExtrapolateError::CapZoneWithoutCaps {
+            |refused| ExtrapolateError::CapZoneWithoutCaps {
                 recording: request.recording.clone(),
-                cap_zone_diameters,
+                cap_zone_diameters: refused.cap_zone_diameters,
             },
         )?;
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
