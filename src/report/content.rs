@@ -964,10 +964,20 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
             return;
         }
     };
+    d.push(costs_table(inp.info.particles, t));
+    d.push(speedup_words(t));
+    costs_sources(d, t);
+    if inp.plots.contains(&SPEEDUP_SVG) {
+        figure(d, "ε_rel at each compared t_k against the speedup of reaching t_k with k − 1 extrapolated periods: ", SPEEDUP_SVG, "Relative error against the speedup of reaching each t_k");
+    }
+}
+
+/// The Table 6 rows: the complete DEM beside the extrapolated one, for `particles`.
+fn costs_table(particles: u32, t: &CostTable) -> Block {
     let m = TABLE_PERIODS as f64;
-    d.push(Block::Table {
+    Block::Table {
         header: vec![
-            format!("{} particles", inp.info.particles),
+            format!("{particles} particles"),
             "Complete DEM".into(),
             "Extrapolated DEM".into(),
         ],
@@ -992,7 +1002,13 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
             ],
         ],
         numeric: true,
-    });
+    }
+}
+
+/// The speedup for the table's periods and per period, and from how many periods the
+/// extrapolation pays.
+fn speedup_words(t: &CostTable) -> Block {
+    let m = TABLE_PERIODS as f64;
     let mut summary = vec![
         text("Speedup: "),
         bold(speedup(t.speedup(m))),
@@ -1009,7 +1025,11 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
             "; an extrapolated period is not cheaper than a DEM period here, so the extrapolation never pays off.",
         )),
     }
-    d.push(para(summary));
+    para(summary)
+}
+
+/// Where each row of the cost table comes from.
+fn costs_sources(d: &mut Document, t: &CostTable) {
     let dem_period = match t.tau_dem_source {
         DemPeriodSource::Reference { periods } => format!(
             "seconds_reference / {periods}: the DEM continued {periods} reference periods after \
@@ -1060,9 +1080,6 @@ fn costs_section(d: &mut Document, inp: &Inputs) {
             )),
         ],
     ]));
-    if inp.plots.contains(&SPEEDUP_SVG) {
-        figure(d, "ε_rel at each compared t_k against the speedup of reaching t_k with k − 1 extrapolated periods: ", SPEEDUP_SVG, "Relative error against the speedup of reaching each t_k");
-    }
 }
 
 fn durations_section(d: &mut Document, inp: &Inputs) {
