@@ -301,11 +301,18 @@ impl Verdict {
 
     /// The verdict in words, from its figures and its `setting`.
     fn words(&self, setting: &Setting) -> String {
-        // what follows the sentence's head, in every judged verdict: the yardstick beside
-        // the median (how the DEM runs themselves score on it, and how often each is
-        // beyond the others' range), then the recorded span left out, the means, the
-        // pattern and whose distance it is
-        let tail = [
+        match (self.passes, self.median_ratio) {
+            (Some(true), Some(m)) => self.passing_words(setting, m),
+            (Some(false), Some(m)) => self.failing_words(setting, m),
+            _ => self.unjudged_words(setting),
+        }
+    }
+
+    /// What follows a judged verdict's head: the yardstick beside the median (how the DEM
+    /// runs themselves score on it, and how often each is beyond the others' range), then
+    /// the recorded span left out, the means, the pattern and whose distance it is.
+    fn tail_words(&self, setting: &Setting) -> String {
+        [
             yardstick_words(
                 self.median_ratio,
                 &self.dem_runs_median_ratio,
@@ -318,16 +325,11 @@ impl Verdict {
             self.pattern_words(),
             self.runs_note(setting),
         ]
-        .concat();
-        match (self.passes, self.median_ratio) {
-            (Some(true), Some(m)) => self.passing_words(setting, m, &tail),
-            (Some(false), Some(m)) => self.failing_words(setting, m, &tail),
-            _ => self.unjudged_words(setting),
-        }
+        .concat()
     }
 
     /// "passes as one more DEM run: …", with the median `m`.
-    fn passing_words(&self, setting: &Setting, m: f64, tail: &str) -> String {
+    fn passing_words(&self, setting: &Setting, m: f64) -> String {
         let beyond = if self.outside_range.is_empty() {
             "never beyond the farthest two".to_string()
         } else {
@@ -340,15 +342,16 @@ impl Verdict {
         };
         format!(
             "passes as one more DEM run: its distance to the DEM runs is {} times theirs to \
-             each other over {} (median {}), {beyond}{tail}",
+             each other over {} (median {}), {beyond}{}",
             self.range_words(),
             instants(&self.compared, self.compared.len()),
             beside_one(m),
+            self.tail_words(setting),
         )
     }
 
     /// "does not pass as one more DEM run: …", with the median `m`.
-    fn failing_words(&self, setting: &Setting, m: f64, tail: &str) -> String {
+    fn failing_words(&self, setting: &Setting, m: f64) -> String {
         let beyond = if self.outside_range.is_empty() {
             String::new()
         } else {
@@ -382,9 +385,10 @@ impl Verdict {
         };
         format!(
             "does not pass as one more DEM run: {} times the DEM runs' distance to each other \
-             over {} (median {median}){beyond}{few}{tail}",
+             over {} (median {median}){beyond}{few}{}",
             self.range_words(),
             instants(&self.compared, self.compared.len()),
+            self.tail_words(setting),
         )
     }
 
