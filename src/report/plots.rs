@@ -1180,124 +1180,155 @@ pub fn field(dem: &Snapshot, extra: &Snapshot, k: u32, drum_radius: Option<f64>)
 /// `drum_radius` about the axis) is drawn when known. Only the particles visible from the
 /// end of the drum are drawn.
 pub fn fields(snaps: &[(&Snapshot, String)], drum_radius: Option<f64>) -> Result<String> {
-    const PANEL: (u32, u32) = (470, 540);
-    const BAR: u32 = 150;
-    const TITLE: u32 = 40;
-    const MARGIN: u32 = 12;
-    const X_LABELS: u32 = 45;
-    const Y_LABELS: u32 = 70;
     let n = snaps.len().max(1) as u32;
-    render((n * PANEL.0 + BAR, PANEL.1), |root| {
+    render((n * FIELD_PANEL.0 + FIELD_BAR, FIELD_PANEL.1), |root| {
         let temps = snaps.iter().flat_map(|(s, _)| s.temp.iter().copied());
         let t_range = span(temps, &[], 0.0);
-        let (t_lo, t_hi) = (t_range.start, t_range.end);
-        let ft = ticks(&t_range);
-        let frac = |t: f64| (t - t_lo) / (t_hi - t_lo);
+        let view = FieldView::of(snaps, drum_radius);
+        let (panels, bar) = root.split_horizontally(n * FIELD_PANEL.0);
+        let parts = panels.split_evenly((1, n as usize));
+        for ((snap, title), part) in snaps.iter().zip(&parts) {
+            field_panel(part, snap, title, &view, &t_range, drum_radius)?;
+        }
+        colour_bar(&bar, &t_range)
+    })
+}
 
-        // One square-scaled window holding every field and the drum.
+/// A field panel's size, the colour bar's width, and their margins (pixels).
+const FIELD_PANEL: (u32, u32) = (470, 540);
+const FIELD_BAR: u32 = 150;
+const FIELD_TITLE: u32 = 40;
+const FIELD_MARGIN: u32 = 12;
+const FIELD_X_LABELS: u32 = 45;
+const FIELD_Y_LABELS: u32 = 70;
+
+/// The window every field panel shows: square-scaled so that a sphere is round, holding every
+/// field and the drum, with the cell size of the visibility test.
+struct FieldView {
+    x: Range<f64>,
+    z: Range<f64>,
+    /// Pixels per metre.
+    scale: f64,
+    /// The visibility test's cell (m): half the smallest radius, at most 2 000 across.
+    cell: f64,
+}
+
+impl FieldView {
+    fn of(snaps: &[(&Snapshot, String)], drum_radius: Option<f64>) -> FieldView {
         let all = || snaps.iter().flat_map(|(s, _)| s.pos.iter().zip(&s.radius));
         let drum: Vec<f64> = drum_radius.map_or(Vec::new(), |r| vec![-r, r]);
         let xs = span(all().flat_map(|(p, r)| [p[0] - r, p[0] + r]), &drum, 0.04);
         let zs = span(all().flat_map(|(p, r)| [p[2] - r, p[2] + r]), &drum, 0.04);
-        let plot_w = (PANEL.0 - 2 * MARGIN - Y_LABELS) as f64;
-        let plot_h = (PANEL.1 - TITLE - 2 * MARGIN - X_LABELS) as f64;
+        let plot_w = (FIELD_PANEL.0 - 2 * FIELD_MARGIN - FIELD_Y_LABELS) as f64;
+        let plot_h = (FIELD_PANEL.1 - FIELD_TITLE - 2 * FIELD_MARGIN - FIELD_X_LABELS) as f64;
         let scale = (plot_w / (xs.end - xs.start)).min(plot_h / (zs.end - zs.start));
         let (cx, cz) = ((xs.start + xs.end) / 2.0, (zs.start + zs.end) / 2.0);
         let (hw, hh) = (plot_w / scale / 2.0, plot_h / scale / 2.0);
         let x = cx - hw..cx + hw;
         let z = cz - hh..cz + hh;
-        let (fx, fz) = (ticks(&x), ticks(&z));
         let r_min = all()
             .map(|(_, r)| *r)
             .filter(|r| r.is_finite() && *r > 0.0)
             .fold(f64::INFINITY, f64::min);
         let cell = (r_min / 2.0).max((x.end - x.start) / 2000.0);
+        FieldView { x, z, scale, cell }
+    }
+}
 
-        let (panels, bar) = root.split_horizontally(n * PANEL.0);
-        let parts = panels.split_evenly((1, n as usize));
-        for ((snap, title), part) in snaps.iter().zip(&parts) {
-            let (head, body) = part.split_vertically(TITLE);
-            let style = TextStyle::from((FONT, 18).into_font()).pos(text_anchor::Pos::new(
-                text_anchor::HPos::Center,
-                text_anchor::VPos::Center,
-            ));
-            let head_w = head.dim_in_pixel().0 as i32;
-            head.draw_text(
-                title,
-                &style,
-                (
-                    MARGIN as i32 + Y_LABELS as i32 + (head_w - (MARGIN + Y_LABELS) as i32) / 2,
-                    TITLE as i32 / 2,
-                ),
-            )?;
-            let mut chart = ChartBuilder::on(&body)
-                .margin(MARGIN)
-                .x_label_area_size(X_LABELS)
-                .y_label_area_size(Y_LABELS)
-                .build_cartesian_2d(x.clone(), z.clone())?;
-            chart
-                .configure_mesh()
-                .disable_mesh()
-                .x_desc("x (m)")
-                .y_desc("z (m)")
-                .axis_desc_style((FONT, 15))
-                .label_style((FONT, 13))
-                .x_labels(6)
-                .y_labels(6)
-                .x_label_formatter(&fx)
-                .y_label_formatter(&fz)
-                .draw()?;
-            if let Some(r) = drum_radius {
-                const SIDES: usize = 180;
-                let circle = (0..=SIDES).map(|i| {
-                    let a = std::f64::consts::TAU * i as f64 / SIDES as f64;
-                    (r * a.cos(), r * a.sin())
-                });
-                chart.draw_series(std::iter::once(PathElement::new(
-                    circle.collect::<Vec<_>>(),
-                    GREY.stroke_width(2),
-                )))?;
-            }
-            let dims = (
-                ((x.end - x.start) / cell).ceil().max(1.0) as usize,
-                ((z.end - z.start) / cell).ceil().max(1.0) as usize,
-            );
-            let shown = visible(snap, (x.start, z.start), cell, dims);
-            chart.draw_series(shown.into_iter().map(|i| {
-                let [px, _, pz] = snap.pos[i];
-                let r = ((snap.radius[i] * scale).round() as i32).max(1);
-                Circle::new((px, pz), r, colour(frac(snap.temp[i])).filled())
-            }))?;
-        }
+/// One snapshot's panel: its title, the axes, the drum's outline and the visible spheres
+/// coloured by temperature on `t_range`.
+fn field_panel(
+    part: &Area,
+    snap: &Snapshot,
+    title: &str,
+    view: &FieldView,
+    t_range: &Range<f64>,
+    drum_radius: Option<f64>,
+) -> Result<()> {
+    let (x, z) = (&view.x, &view.z);
+    let (head, body) = part.split_vertically(FIELD_TITLE);
+    let style = TextStyle::from((FONT, 18).into_font()).pos(text_anchor::Pos::new(
+        text_anchor::HPos::Center,
+        text_anchor::VPos::Center,
+    ));
+    let head_w = head.dim_in_pixel().0 as i32;
+    let labels = (FIELD_MARGIN + FIELD_Y_LABELS) as i32;
+    head.draw_text(
+        title,
+        &style,
+        (labels + (head_w - labels) / 2, FIELD_TITLE as i32 / 2),
+    )?;
+    let mut chart = ChartBuilder::on(&body)
+        .margin(FIELD_MARGIN)
+        .x_label_area_size(FIELD_X_LABELS)
+        .y_label_area_size(FIELD_Y_LABELS)
+        .build_cartesian_2d(x.clone(), z.clone())?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc("x (m)")
+        .y_desc("z (m)")
+        .axis_desc_style((FONT, 15))
+        .label_style((FONT, 13))
+        .x_labels(6)
+        .y_labels(6)
+        .x_label_formatter(&ticks(x))
+        .y_label_formatter(&ticks(z))
+        .draw()?;
+    if let Some(r) = drum_radius {
+        const SIDES: usize = 180;
+        let circle = (0..=SIDES).map(|i| {
+            let a = std::f64::consts::TAU * i as f64 / SIDES as f64;
+            (r * a.cos(), r * a.sin())
+        });
+        chart.draw_series(std::iter::once(PathElement::new(
+            circle.collect::<Vec<_>>(),
+            GREY.stroke_width(2),
+        )))?;
+    }
+    let dims = (
+        ((x.end - x.start) / view.cell).ceil().max(1.0) as usize,
+        ((z.end - z.start) / view.cell).ceil().max(1.0) as usize,
+    );
+    let frac = |t: f64| (t - t_range.start) / (t_range.end - t_range.start);
+    let shown = visible(snap, (x.start, z.start), view.cell, dims);
+    chart.draw_series(shown.into_iter().map(|i| {
+        let [px, _, pz] = snap.pos[i];
+        let r = ((snap.radius[i] * view.scale).round() as i32).max(1);
+        Circle::new((px, pz), r, colour(frac(snap.temp[i])).filled())
+    }))?;
+    Ok(())
+}
 
-        // The colour bar.
-        let (_, bar_body) = bar.split_vertically(TITLE);
-        let mut chart = ChartBuilder::on(&bar_body)
-            .margin(MARGIN)
-            .margin_left(4)
-            .margin_right(24)
-            .x_label_area_size(X_LABELS)
-            .y_label_area_size(64)
-            .build_cartesian_2d(0.0..1.0, t_lo..t_hi)?;
-        chart
-            .configure_mesh()
-            .disable_mesh()
-            .x_labels(0)
-            .y_desc("temperature T (K)")
-            .axis_desc_style((FONT, 15))
-            .label_style((FONT, 13))
-            .y_label_formatter(&ft)
-            .draw()?;
-        const STEPS: usize = 64;
-        chart.draw_series((0..STEPS).map(|i| {
-            let (a, b) = (i as f64 / STEPS as f64, (i + 1) as f64 / STEPS as f64);
-            let t = |f: f64| t_lo + f * (t_hi - t_lo);
-            // Each band overlaps the next by half a band: no seams between them.
-            let top = (b + 0.5 / STEPS as f64).min(1.0);
-            Rectangle::new([(0.0, t(a)), (1.0, t(top))], colour((a + b) / 2.0).filled())
-        }))?;
-        Ok(())
-    })
+/// The temperature colour bar beside the field panels.
+fn colour_bar(bar: &Area, t_range: &Range<f64>) -> Result<()> {
+    let (t_lo, t_hi) = (t_range.start, t_range.end);
+    let (_, bar_body) = bar.split_vertically(FIELD_TITLE);
+    let mut chart = ChartBuilder::on(&bar_body)
+        .margin(FIELD_MARGIN)
+        .margin_left(4)
+        .margin_right(24)
+        .x_label_area_size(FIELD_X_LABELS)
+        .y_label_area_size(64)
+        .build_cartesian_2d(0.0..1.0, t_lo..t_hi)?;
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_labels(0)
+        .y_desc("temperature T (K)")
+        .axis_desc_style((FONT, 15))
+        .label_style((FONT, 13))
+        .y_label_formatter(&ticks(t_range))
+        .draw()?;
+    const STEPS: usize = 64;
+    chart.draw_series((0..STEPS).map(|i| {
+        let (a, b) = (i as f64 / STEPS as f64, (i + 1) as f64 / STEPS as f64);
+        let t = |f: f64| t_lo + f * (t_hi - t_lo);
+        // Each band overlaps the next by half a band: no seams between them.
+        let top = (b + 0.5 / STEPS as f64).min(1.0);
+        Rectangle::new([(0.0, t(a)), (1.0, t(top))], colour((a + b) / 2.0).filled())
+    }))?;
+    Ok(())
 }
 
 /// The size classes' colours, smallest radius first (cycled past six classes).
