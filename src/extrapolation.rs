@@ -306,14 +306,29 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
     print(&request, outcome, plan.json)
 }
 
-/// Extrapolates `request` on `threads` workers, its notices told on stderr (the demo and the
-/// studies: their own context, not `tdex extrapolate`'s advice about flags).
+/// Extrapolates `request` on `threads` workers, its notices told on stderr (the demo: its own
+/// context, not `tdex extrapolate`'s advice about flags).
 pub fn extrapolate_on(
     threads: usize,
     request: &ExtrapolationRequest,
 ) -> Result<ExtrapolationOutcome> {
     crate::with_workers(threads, || {
         Ok(extrapolate::extrapolate_recording(request, tell)?)
+    })
+}
+
+/// Extrapolates `request` for a study: as [`extrapolate_on`], but the memory plan is told
+/// only where the table does not stay in memory. A study replays one recording many times
+/// (every P, map and draw), and a line for each replay that fits would bury its table.
+pub fn extrapolate_for_study(
+    threads: usize,
+    request: &ExtrapolationRequest,
+) -> Result<ExtrapolationOutcome> {
+    crate::with_workers(threads, || {
+        Ok(extrapolate::extrapolate_recording(
+            request,
+            tell_unless_it_fits,
+        )?)
     })
 }
 
@@ -374,6 +389,16 @@ pub fn tell(notice: Notice<'_>) {
             eprintln!("warning: {e}; the pairing will be computed again next time")
         }
     }
+}
+
+/// Tells a [`Notice`] as [`tell`] does, but for a memory plan whose table fits in memory.
+fn tell_unless_it_fits(notice: Notice<'_>) {
+    if let Notice::Memory { plan, .. } = &notice {
+        if matches!(plan.reason, ModeReason::Fits) {
+            return;
+        }
+    }
+    tell(notice)
 }
 
 /// Rows a second that decoding the table costs, each period, when it is streamed: the
