@@ -65,7 +65,7 @@ pub fn run(plan: &DemoPlan) -> Result<()> {
         extra.clone(),
         extrapolation::memory_limit(None),
     );
-    let outcome = extrapolation::extrapolate_on(plan.threads, &request)?;
+    let outcome = extrapolation::extrapolate_on(plan.threads, &request, extrapolation::tell)?;
     extrapolation::print(&request, outcome, false)?;
 
     println!("3/4 compare   against the DEM reference and its twin");

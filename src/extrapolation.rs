@@ -306,29 +306,16 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
     print(&request, outcome, plan.json)
 }
 
-/// Extrapolates `request` on `threads` workers, its notices told on stderr (the demo: its own
-/// context, not `tdex extrapolate`'s advice about flags).
+/// Extrapolates `request` on `threads` workers, its notices told by `told` ([`tell`], or
+/// [`tell_unless_it_fits`] for a study): the demo's and the studies' own context, not `tdex
+/// extrapolate`'s advice about flags.
 pub fn extrapolate_on(
     threads: usize,
     request: &ExtrapolationRequest,
+    told: fn(Notice<'_>),
 ) -> Result<ExtrapolationOutcome> {
     crate::with_workers(threads, || {
-        Ok(extrapolate::extrapolate_recording(request, tell)?)
-    })
-}
-
-/// Extrapolates `request` for a study: as [`extrapolate_on`], but the memory plan is told
-/// only where the table does not stay in memory. A study replays one recording many times
-/// (every P, map and draw), and a line for each replay that fits would bury its table.
-pub fn extrapolate_for_study(
-    threads: usize,
-    request: &ExtrapolationRequest,
-) -> Result<ExtrapolationOutcome> {
-    crate::with_workers(threads, || {
-        Ok(extrapolate::extrapolate_recording(
-            request,
-            tell_unless_it_fits,
-        )?)
+        Ok(extrapolate::extrapolate_recording(request, told)?)
     })
 }
 
@@ -391,8 +378,10 @@ pub fn tell(notice: Notice<'_>) {
     }
 }
 
-/// Tells a [`Notice`] as [`tell`] does, but for a memory plan whose table fits in memory.
-fn tell_unless_it_fits(notice: Notice<'_>) {
+/// Tells a [`Notice`] as [`tell`] does, but for a memory plan whose table fits in memory. A
+/// study replays one recording many times (every P, map and draw), and a line for each
+/// replay that fits would bury its table.
+pub fn tell_unless_it_fits(notice: Notice<'_>) {
     if let Notice::Memory { plan, .. } = &notice {
         if matches!(plan.reason, ModeReason::Fits) {
             return;

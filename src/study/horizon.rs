@@ -357,12 +357,12 @@ fn run_one(
             extrapolation::memory_limit(None),
         )
     };
-    let outcome = extrapolation::extrapolate_for_study(plan.threads, &request).with_context(
-        || match draw {
+    let outcome =
+        extrapolation::extrapolate_on(plan.threads, &request, extrapolation::tell_unless_it_fits)
+            .with_context(|| match draw {
             Some(d) => format!("extrapolating {d} with {p} recorded period(s)"),
             None => format!("extrapolating with {p} recorded period(s)"),
-        },
-    )?;
+        })?;
     let ext = ExtrapolationReader::open(&extra)?;
     let comparison = compare::compare(rec, &ext, plan.cells, compare::DEFAULT_SEED)?;
     let mut entry = Entry::new(

@@ -122,7 +122,9 @@ pub fn evaluate(
         extra.to_path_buf(),
         extrapolation::memory_limit(None),
     );
-    if let Err(e) = extrapolation::extrapolate_for_study(threads, &request) {
+    if let Err(e) =
+        extrapolation::extrapolate_on(threads, &request, extrapolation::tell_unless_it_fits)
+    {
         // a refused extrapolation (e.g. the explicit scheme's CFL guard) is a study result
         return Ok(Outcome::table_only(&rec, format!("{e:#}")));
     }
