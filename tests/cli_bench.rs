@@ -99,3 +99,46 @@ fn the_bench_names_the_vector_instructions_it_ran_with() {
         "{text}"
     );
 }
+
+#[test]
+fn a_case_the_deck_cannot_model_is_refused_before_the_dem() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = short_small_drum(dir.path());
+    let text = std::fs::read_to_string(&case).unwrap();
+    for (field, from, to, why) in [
+        (
+            "the Hertz contact area",
+            "contact_area = \"overlap\"",
+            "contact_area = \"hertz\"",
+            "has no Hertz contact area",
+        ),
+        (
+            "a periodic section",
+            "end_caps = \"rotating\"",
+            "end_caps = \"periodic\"",
+            "closes the drum with end caps",
+        ),
+    ] {
+        assert!(text.contains(from), "small_drum no longer sets {from}");
+        let changed = dir.path().join("changed.toml");
+        std::fs::write(&changed, text.replace(from, to)).unwrap();
+        let peer = dir.path().join("peer");
+        let o = run_tdex(&[
+            "bench",
+            changed.to_str().unwrap(),
+            "--steps",
+            "20",
+            "--vs-liggghts",
+            "--liggghts-dir",
+            peer.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{field}: {err}");
+        assert!(
+            err.contains("changed.toml") && err.contains(why),
+            "{field}: {err}"
+        );
+        // refused in the plan: no DEM to t0, so no bed written for the peer
+        assert!(!peer.exists(), "{field}");
+    }
+}

@@ -29,6 +29,13 @@ pub struct PeerRate {
     pub dir: PathBuf,
 }
 
+/// Whether the deck can reproduce `case`: checked in the plan, before the DEM to `t0`.
+pub fn check_deck(case: &Case) -> Result<()> {
+    DeckBed::of(case)?;
+    DrumMeshes::of(case.drum.end_caps)?;
+    Ok(())
+}
+
 /// Writes tdex's bed at `t0` and the deck into `dir` (a new temporary directory if `None`), to
 /// be run by [`run`]; returns the directory. Called at `t0`, before tdex's timed steps, so that
 /// the bed is written as it streams out rather than kept.
@@ -151,66 +158,120 @@ fn box_half_widths(case: &Case) -> (f64, f64) {
     (case.drum.radius + 0.01, case.drum.length / 2.0 + 0.01)
 }
 
+/// What of the case the deck reproduces: LIGGGHTS 3.8's conduction and the deck's insertion
+/// cover one size, a split start, the overlap contact area and an adiabatic drum closed by caps.
+struct DeckBed {
+    hot: f64,
+    cold: f64,
+    /// The split axis' index (0 = x, 1 = y, 2 = z).
+    axis: usize,
+    radius: f64,
+}
+
+impl DeckBed {
+    fn of(case: &Case) -> Result<Self> {
+        let TemperatureSpec::Split {
+            hot,
+            cold,
+            split_axis,
+        } = case.temperature
+        else {
+            bail!("--vs-liggghts: the deck needs temperature.mode = \"split\" (the case has a uniform start)");
+        };
+        if case.conduction.contact_area != ContactArea::Overlap {
+            bail!("--vs-liggghts: LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area (the case sets conduction.contact_area = \"hertz\")");
+        }
+        if case.drum.wall_temperature.is_some() {
+            bail!(
+                "--vs-liggghts: the deck has no heated wall (the case sets drum.wall_temperature)"
+            );
+        }
+        let ParticleSize::Single { radius } = case.particles.size else {
+            bail!("--vs-liggghts: the deck inserts spheres of one size (the case gives several)");
+        };
+        Ok(Self {
+            hot,
+            cold,
+            axis: split_axis.index(),
+            radius,
+        })
+    }
+}
+
+/// The drum as LIGGGHTS meshes: one turning mesh, or a turning mantle and fixed caps.
+struct DrumMeshes {
+    /// STL file, with the mantle, with the caps.
+    files: Vec<(&'static str, bool, bool)>,
+    fixes: &'static str,
+    count: usize,
+    names: &'static str,
+    /// The mesh `fix move/mesh` turns.
+    rotating: &'static str,
+}
+
+impl DrumMeshes {
+    fn of(end_caps: EndCaps) -> Result<Self> {
+        Ok(match end_caps {
+            EndCaps::Rotating => Self {
+                files: vec![("drum.stl", true, true)],
+                fixes: "fix drum all mesh/surface file drum.stl type 2",
+                count: 1,
+                names: "drum",
+                rotating: "drum",
+            },
+            EndCaps::Fixed => Self {
+                files: vec![
+                    ("drum_mantle.stl", true, false),
+                    ("drum_caps.stl", false, true),
+                ],
+                fixes: "fix mantle all mesh/surface file drum_mantle.stl type 2\nfix caps all mesh/surface file drum_caps.stl type 2",
+                count: 2,
+                names: "mantle caps",
+                rotating: "mantle",
+            },
+            EndCaps::Periodic => bail!("--vs-liggghts: the deck closes the drum with end caps (the case sets drum.end_caps = \"periodic\")"),
+        })
+    }
+
+    fn write(&self, case: &Case, dir: &Path) -> Result<()> {
+        for &(file, mantle, caps) in &self.files {
+            let stl = drum_stl(case.drum.radius, case.drum.length, mantle, caps);
+            tdex_format::output::write_atomically(&dir.join(file), stl.as_bytes())?;
+        }
+        Ok(())
+    }
+}
+
 /// Writes `in.drum` and the drum mesh for `case`, heating for `heating_steps` after `t0`.
 fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> Result<()> {
-    let TemperatureSpec::Split {
-        hot,
-        cold,
-        split_axis,
-    } = case.temperature
-    else {
-        bail!("--vs-liggghts: the deck needs temperature.mode = \"split\" (the case has a uniform start)");
-    };
-    if case.conduction.contact_area != ContactArea::Overlap {
-        bail!("--vs-liggghts: LIGGGHTS 3.8 heat/gran/conduction has no Hertz contact area (the case sets conduction.contact_area = \"hertz\")");
-    }
-    if case.drum.wall_temperature.is_some() {
-        bail!("--vs-liggghts: the deck has no heated wall (the case sets drum.wall_temperature)");
-    }
-    let ParticleSize::Single { radius: rp } = case.particles.size else {
-        bail!("--vs-liggghts: the deck inserts spheres of one size (the case gives several)");
-    };
-    let (r, l) = (case.drum.radius, case.drum.length);
-    let (meshes, mesh_fixes, n_meshes, names, rotating) = match case.drum.end_caps {
-        EndCaps::Rotating => (
-            vec![("drum.stl", true, true)],
-            "fix drum all mesh/surface file drum.stl type 2".to_string(),
-            1,
-            "drum",
-            "drum",
-        ),
-        EndCaps::Fixed => (
-            vec![
-                ("drum_mantle.stl", true, false),
-                ("drum_caps.stl", false, true),
-            ],
-            "fix mantle all mesh/surface file drum_mantle.stl type 2\nfix caps all mesh/surface file drum_caps.stl type 2".to_string(),
-            2,
-            "mantle caps",
-            "mantle",
-        ),
-        EndCaps::Periodic => bail!("--vs-liggghts: the deck closes the drum with end caps (the case sets drum.end_caps = \"periodic\")"),
-    };
-    for (file, mantle, caps) in meshes {
-        let path = dir.join(file);
-        tdex_format::output::write_atomically(&path, drum_stl(r, l, mantle, caps).as_bytes())?;
-    }
-    let axis = split_axis.index();
-    // The split plane's extent along its axis: the box's half-width on that axis.
-    let (across, along) = box_half_widths(case);
-    let ext = if axis == 1 { along } else { across };
-    let block = |upper: &str| {
-        let mut b = ["INF"; 6];
-        b[2 * axis + 1] = upper;
-        b.join(" ")
-    };
+    let bed = DeckBed::of(case)?;
+    let meshes = DrumMeshes::of(case.drum.end_caps)?;
+    meshes.write(case, dir)?;
+    let mut values = deck_values(case, case_path, &bed, &meshes);
+    values.extend(split_values(case, &bed));
+    values.push(("nheat", heating_steps.to_string()));
+    values.push(("heat_runs", format!("run {heating_steps}")));
+    let start = fill(START_FROM_STATE, &values)?;
+    values.push(("start", start));
+    let deck = fill(DECK, &values)?;
+    tdex_format::output::write_atomically(&dir.join("in.drum"), deck.as_bytes())?;
+    Ok(())
+}
+
+/// The template's values for the case's materials, contact laws and drum.
+fn deck_values(
+    case: &Case,
+    case_path: &Path,
+    bed: &DeckBed,
+    meshes: &DrumMeshes,
+) -> Vec<(&'static str, String)> {
     let (m, pp, pw) = (
         &case.material,
         &case.contact.particle_particle,
         &case.contact.particle_wall,
     );
     let e_real = case.conduction.youngs_modulus_real;
-    let mut values: Vec<(&str, String)> = vec![
+    vec![
         (
             "case",
             case_path
@@ -220,7 +281,7 @@ fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> 
         ("name", case.name.clone()),
         ("seed", case.seed.to_string()),
         ("box", format!("read_data       {STATE_FILE}")),
-        ("skin", (0.4 * rp).to_string()),
+        ("skin", (0.4 * bed.radius).to_string()),
         ("E", m.youngs_modulus.to_string()),
         ("nu", m.poisson_ratio.to_string()),
         ("k", m.conductivity.to_string()),
@@ -252,29 +313,35 @@ fn write_deck(case: &Case, case_path: &Path, heating_steps: u64, dir: &Path) -> 
             "area_corr",
             if e_real.is_some() { "yes" } else { "no" }.into(),
         ),
-        ("mesh_fixes", mesh_fixes),
-        ("n_meshes", n_meshes.to_string()),
-        ("meshes", names.into()),
-        ("rotating", rotating.into()),
-        ("T_init", (0.5 * (hot + cold)).to_string()),
-        ("T_hot", hot.to_string()),
-        ("T_cold", cold.to_string()),
+        ("mesh_fixes", meshes.fixes.into()),
+        ("n_meshes", meshes.count.to_string()),
+        ("meshes", meshes.names.into()),
+        ("rotating", meshes.rotating.into()),
         ("period", case.drum.rotation_period.to_string()),
-        ("nheat", heating_steps.to_string()),
         // the import test's dumps (tests/liggghts/deck_from_case.py --dumps) are not timed here
         ("pair_compute", String::new()),
-        ("heat_runs", format!("run {heating_steps}")),
-        ("ax", ["x", "y", "z"][axis].into()),
+    ]
+}
+
+/// The template's values for the split start: the temperatures and the bisected plane.
+fn split_values(case: &Case, bed: &DeckBed) -> Vec<(&'static str, String)> {
+    // The split plane's extent along its axis: the box's half-width on that axis.
+    let (across, along) = box_half_widths(case);
+    let ext = if bed.axis == 1 { along } else { across };
+    let block = |upper: &str| {
+        let mut b = ["INF"; 6];
+        b[2 * bed.axis + 1] = upper;
+        b.join(" ")
+    };
+    vec![
+        ("T_init", (0.5 * (bed.hot + bed.cold)).to_string()),
+        ("T_hot", bed.hot.to_string()),
+        ("T_cold", bed.cold.to_string()),
+        ("ax", ["x", "y", "z"][bed.axis].into()),
         ("ext", ext.to_string()),
         ("tmp_block", block("${mid}")),
         ("hot_block", block("${split}")),
-    ];
-    let start = fill(START_FROM_STATE, &values)?;
-    values.push(("start", start));
-    let deck = fill(DECK, &values)?;
-    let path = dir.join("in.drum");
-    tdex_format::output::write_atomically(&path, deck.as_bytes())?;
-    Ok(())
+    ]
 }
 
 /// `template` with every `@key@` replaced by its value.

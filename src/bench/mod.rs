@@ -5,6 +5,7 @@ mod liggghts;
 mod record;
 
 pub use engine::engine;
+pub use liggghts::check_deck;
 pub use record::record;
 
 /// Peak resident memory of this process so far (bytes), from `VmHWM` in `/proc/self/status`;

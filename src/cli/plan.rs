@@ -600,6 +600,11 @@ impl BenchPlan {
         if let Some(dir) = &args.liggghts_dir {
             check_dir("--liggghts-dir", dir, "the LIGGGHTS deck and log")?;
         }
+        if args.vs_liggghts {
+            // before the DEM to t0, which on a large case takes minutes
+            crate::bench::check_deck(&case)
+                .map_err(|e| usage(format!("{}: {e:#}", case_path.display())))?;
+        }
         Ok(BenchPlan {
             case_path,
             case,
