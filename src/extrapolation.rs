@@ -296,7 +296,7 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         reproducible: plan.reproducible,
         recorded_periods: plan.recorded_periods,
         path_seed: plan.seed,
-        jump_targets: plan.jump_to.clone(),
+        jumps: plan.jumps.clone(),
         symmetry: plan.symmetry,
         boundary: plan.boundary,
     };

@@ -394,6 +394,72 @@ fn three_recorded_periods_replay_the_recording_then_jump_along_a_seeded_path() {
     }
 }
 
+/// `--jump-nearest K`: the path jumps only into the K starts whose pairing with the end is
+/// shortest (`tdex pair` ranks them), and is then the path `--jump-to` those starts gives, to
+/// the byte; K = every start is the default path; it cannot be given with `--jump-to`.
+#[test]
+fn jump_nearest_enters_the_starts_nearest_the_recordings_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = setup(dir.path());
+    let p4 = dir.path().join("p4.mcap");
+    record(&case, &p4, &["--recorded-periods", "4", "--reference", "5"]);
+    let pairs: serde_json::Value =
+        serde_json::from_str(&tdex_ok(&["pair", p4.to_str().unwrap(), "--json"])).unwrap();
+    let mut by_distance: Vec<(f64, u64)> = pairs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| {
+            let distance = p["mean_distance_diameters"].as_f64().unwrap();
+            (distance, p["start"].as_u64().unwrap() + 1)
+        })
+        .collect();
+    by_distance.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert!(
+        by_distance[1].0 < by_distance[2].0,
+        "no two starts nearest: {by_distance:?}"
+    );
+    let mut nearest: Vec<u64> = by_distance[..2].iter().map(|&(_, p)| p).collect();
+    nearest.sort_unstable();
+    let listed: Vec<String> = nearest.iter().map(u64::to_string).collect();
+
+    let (by_rank, by_hand) = (dir.path().join("rank.mcap"), dir.path().join("hand.mcap"));
+    let json = extrapolate(&p4, &by_rank, "12", &["--jump-nearest", "2"]);
+    assert_eq!(json["path"]["jump_targets"], serde_json::json!(nearest));
+    extrapolate(&p4, &by_hand, "12", &["--jump-to", &listed.join(",")]);
+    assert_eq!(
+        std::fs::read(&by_rank).unwrap(),
+        std::fs::read(&by_hand).unwrap()
+    );
+
+    let (every, default) = (
+        dir.path().join("every.mcap"),
+        dir.path().join("default.mcap"),
+    );
+    let json = extrapolate(&p4, &every, "12", &["--jump-nearest", "4"]);
+    assert!(json["path"]["jump_targets"].is_null(), "{json}");
+    extrapolate(&p4, &default, "12", &[]);
+    assert_eq!(
+        std::fs::read(&every).unwrap(),
+        std::fs::read(&default).unwrap()
+    );
+
+    let o = run_tdex(&[
+        "extrapolate",
+        p4.to_str().unwrap(),
+        "--periods",
+        "2",
+        "-o",
+        every.to_str().unwrap(),
+        "--jump-nearest",
+        "2",
+        "--jump-to",
+        "1",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+}
+
 /// An extrapolation of several recorded periods is the recorded run itself until its first
 /// jump (t2 … tP'): `tdex compare` shows those t_k, in parentheses, but leaves them out of
 /// the verdict, whose median they would only flatter; the paper's method (one period)

@@ -222,6 +222,17 @@ pub struct ExtrapolateArgs {
         value_parser = periods_used()
     )]
     pub jump_to: Option<Vec<u32>>,
+    /// Jump only into the K recorded periods whose start is nearest the recording's end
+    /// (the mean distance of its pairing with the end), as recurrence CFD jumps to the
+    /// recorded states most like the current one: for a bed that drifts slowly over the
+    /// recording. Pairs every start (stored beside the recording for the next run).
+    #[arg(
+        long = "jump-nearest",
+        value_name = "K",
+        conflicts_with = "jump_to",
+        value_parser = nearest_starts()
+    )]
+    pub jump_nearest: Option<u32>,
     /// Use the drum's mirror symmetry (its mid-plane y = 0): every jump enters the mirror
     /// image of the recorded start, so the periods replayed alternate between the recording
     /// and its mirror image (docs/method.md §6). Costs one more pairing per start; needs a
@@ -747,6 +758,11 @@ fn periods() -> super::values::Count<u32> {
 /// `tdex extrapolate --recorded-periods`: at least one.
 fn periods_used() -> super::values::Count<u32> {
     count(1, "a whole number", "use at least 1 recorded period")
+}
+
+/// `tdex extrapolate --jump-nearest`: at least one start.
+fn nearest_starts() -> super::values::Count<u32> {
+    count(1, "a whole number", "give at least 1 start to jump to")
 }
 
 /// `tdex extrapolate --boundary-pool`: at least one pairing.

@@ -195,8 +195,8 @@ pub struct ExtrapolatePlan {
     pub recorded_periods: Option<u32>,
     /// `--seed`: the recurrence path's seed (`None`: the case's).
     pub seed: Option<u64>,
-    /// `--jump-to`: the periods a jump may enter (`None`: all the periods used).
-    pub jump_to: Option<Vec<u32>>,
+    /// `--jump-to` or `--jump-nearest`: the starts a jump may enter.
+    pub jumps: extrapolate::JumpStarts,
     /// `--mirror`: the drum's mirror symmetry used at the jumps.
     pub symmetry: Symmetry,
     /// `--boundary` with its pool and cell width.
@@ -444,7 +444,14 @@ impl ExtrapolatePlan {
             reproducible: args.reproducible,
             recorded_periods: args.recorded_periods,
             seed: args.seed,
-            jump_to: args.jump_to,
+            jumps: match (args.jump_to, args.jump_nearest) {
+                (Some(listed), _) => extrapolate::JumpStarts::Listed(listed),
+                (None, Some(k)) => std::num::NonZeroU32::new(k).map_or(
+                    extrapolate::JumpStarts::Every,
+                    extrapolate::JumpStarts::Nearest,
+                ),
+                (None, None) => extrapolate::JumpStarts::Every,
+            },
             symmetry: if args.mirror {
                 Symmetry::AxialMirror
             } else {

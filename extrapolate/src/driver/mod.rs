@@ -39,10 +39,8 @@ pub struct ExtrapolationRequest {
     /// Seed of the recurrence path's jumps (`None`: the case's `seed`, else 0). Plays no
     /// part with one recorded period.
     pub path_seed: Option<u64>,
-    /// The recorded periods (1-based, within the `recorded_periods` used) a jump may enter;
-    /// `None`: every one of them. A user restricts them to the starts whose pairing with
-    /// the recording's end is short (`tdex pair` prints each one's distance).
-    pub jump_targets: Option<Vec<u32>>,
+    /// The recorded starts a jump may enter.
+    pub jumps: JumpStarts,
     /// The drum's symmetry the jumps use: [`Symmetry::AxialMirror`] enters the mirror image
     /// of each start, alternating the recording and its image at every jump.
     pub symmetry: Symmetry,
@@ -71,11 +69,24 @@ impl ExtrapolationRequest {
             reproducible: false,
             recorded_periods: None,
             path_seed: None,
-            jump_targets: None,
+            jumps: JumpStarts::Every,
             symmetry: Symmetry::None,
             boundary: BoundaryMaps::Exact,
         }
     }
+}
+
+/// Which recorded starts the path's jumps may enter (each jump draws one uniformly among them).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum JumpStarts {
+    /// Every recorded period used.
+    Every,
+    /// The recorded periods named (1-based, within the recorded periods used).
+    Listed(Vec<u32>),
+    /// The `k` starts nearest the recording's end in the mean distance of their pairing
+    /// with it, as recurrence CFD jumps to the recorded states most like the current one: a
+    /// bed that drifts slowly over the recording is then entered where it stands.
+    Nearest(std::num::NonZeroU32),
 }
 
 /// Where the replay keeps the collision table.
@@ -134,7 +145,7 @@ pub fn extrapolate_recording(
     request: &ExtrapolationRequest,
     mut notice: impl FnMut(Notice<'_>),
 ) -> Result<ExtrapolationOutcome, ExtrapolateError> {
-    let mut run = Extrapolation::plan(request)?;
+    let mut run = Extrapolation::plan(request, &mut notice)?;
     let memory = run.memory_plan(&mut notice)?;
     run.pair(&mut notice)?;
     run.read_tables(memory.mode)?;

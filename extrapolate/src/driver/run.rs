@@ -3,8 +3,8 @@
 //! plan, the pairings, the tables, the replay written out, the outcome.
 
 use super::{
-    axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, MirrorCheck,
-    Notice, TableChoice,
+    axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, JumpStarts,
+    MirrorCheck, Notice, TableChoice,
 };
 use crate::boundary::{self, AxialEnds, BoundaryMaps, Pool, PoolDraws, Redraws};
 use crate::cache;
@@ -91,8 +91,12 @@ pub(super) struct Replayed {
 
 impl<'a> Extrapolation<'a> {
     /// Holds the request against the recording and lays the path out: the recorded periods
-    /// used, the jumps, the snapshots and the pairings already stored for its starts.
-    pub(super) fn plan(request: &'a ExtrapolationRequest) -> Result<Self, ExtrapolateError> {
+    /// used, the jumps, the snapshots and the pairings already stored for its starts (with
+    /// [`JumpStarts::Nearest`], every start's pairing, which ranks them).
+    pub(super) fn plan(
+        request: &'a ExtrapolationRequest,
+        notice: &mut impl FnMut(Notice<'_>),
+    ) -> Result<Self, ExtrapolateError> {
         let reader = RecordingReader::open(&request.recording)?;
         let info = reader.info().clone();
         let used = request.recorded_periods.unwrap_or(info.recorded_periods);
@@ -120,7 +124,18 @@ impl<'a> Extrapolation<'a> {
             },
         )?;
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
-        let targets = jump_targets(request, used)?;
+        let snaps = (0..=used)
+            .map(|index| cache::snapshot(&reader, index))
+            .collect::<Result<Vec<Snapshot>, _>>()?;
+        let mut ranking = StartRanking::default();
+        let targets = match &request.jumps {
+            JumpStarts::Every => None,
+            JumpStarts::Listed(listed) => listed_targets(request, listed, used)?,
+            JumpStarts::Nearest(k) => {
+                ranking = StartRanking::of(request, &reader, &info, &snaps, notice)?;
+                ranking.nearest(k.get(), used)
+            }
+        };
         let steps: Vec<Step> =
             RecurrencePolicy::with_targets(used, seed, targets.as_deref().unwrap_or(&[]))
                 .take(request.periods as usize)
@@ -137,9 +152,6 @@ impl<'a> Extrapolation<'a> {
         for s in &steps {
             replayed[s.period() as usize - 1] = true;
         }
-        let snaps = (0..=used)
-            .map(|index| cache::snapshot(&reader, index))
-            .collect::<Result<Vec<Snapshot>, _>>()?;
         let bodies = Bodies::of(&info, &snaps[0]);
         let end = &snaps[used as usize];
         let found = starts
@@ -169,8 +181,8 @@ impl<'a> Extrapolation<'a> {
             boundary: request.boundary.with_seed(seed),
             redraws,
             pools: Vec::new(),
-            seconds_pairing: 0.0,
-            pairing_reused: true,
+            seconds_pairing: ranking.seconds,
+            pairing_reused: ranking.reused,
             tables: Vec::new(),
             rows: 0,
             max_cfl: 0.0,
@@ -566,23 +578,92 @@ impl<'a> Extrapolation<'a> {
 
 /// The jump targets a request names, checked against the `used` recorded periods; `None`
 /// when they are every period used, the default path.
-fn jump_targets(
+fn listed_targets(
     request: &ExtrapolationRequest,
+    listed: &[u32],
     used: u32,
 ) -> Result<Option<Vec<u32>>, ExtrapolateError> {
-    let Some(targets) = &request.jump_targets else {
-        return Ok(None);
-    };
-    if let Some(&bad) = targets.iter().find(|t| !(1..=used).contains(*t)) {
+    if let Some(&bad) = listed.iter().find(|t| !(1..=used).contains(*t)) {
         return Err(ExtrapolateError::JumpTarget {
             recording: request.recording.clone(),
             target: bad,
             used,
         });
     }
-    let targets = path::distinct_ascending(targets);
-    // every period as a target is the default path: nothing to record
-    Ok((!targets.is_empty() && targets.len() < used as usize).then_some(targets))
+    Ok(unless_every(path::distinct_ascending(listed), used))
+}
+
+/// `targets`, or `None` when they are every period used: the default path, nothing to record.
+fn unless_every(targets: Vec<u32>, used: u32) -> Option<Vec<u32>> {
+    (!targets.is_empty() && targets.len() < used as usize).then_some(targets)
+}
+
+/// Every start of the recording ranked by the mean distance (diameters) of its pairing with
+/// the end `t_P'`, the recurrence norm [`JumpStarts::Nearest`] chooses by: each pairing
+/// reused or computed and stored, as the path's own are.
+#[derive(Default)]
+struct StartRanking {
+    /// (mean distance, period), nearest first; ties to the earlier period.
+    by_distance: Vec<(f64, u32)>,
+    /// Wall time of the pairings computed here.
+    seconds: f64,
+    /// Whether every pairing was found stored.
+    reused: bool,
+}
+
+impl StartRanking {
+    fn of(
+        request: &ExtrapolationRequest,
+        reader: &RecordingReader,
+        info: &RecordingInfo,
+        snaps: &[Snapshot],
+        notice: &mut impl FnMut(Notice<'_>),
+    ) -> Result<Self, ExtrapolateError> {
+        let end = &snaps[snaps.len() - 1];
+        let mut ranking = StartRanking {
+            reused: true,
+            ..Self::default()
+        };
+        for period in 1..snaps.len() as u32 {
+            let start = &snaps[period as usize - 1];
+            let stored = match cache::load(reader, start, end) {
+                Some(stored) => stored,
+                None => {
+                    let started = Instant::now();
+                    let mut stored = cache::compute(start, end, axial_period(info))?;
+                    if request.reproducible {
+                        stored.summary = stored.summary.reproducible();
+                    }
+                    if let Err(e) =
+                        cache::store_image(reader, end.index, start.index, Symmetry::None, &stored)
+                    {
+                        notice(Notice::PairingNotStored(&e));
+                    }
+                    ranking.seconds += started.elapsed().as_secs_f64();
+                    ranking.reused = false;
+                    stored
+                }
+            };
+            ranking
+                .by_distance
+                .push((stored.summary.mean_distance_diameters, period));
+        }
+        ranking
+            .by_distance
+            .sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        Ok(ranking)
+    }
+
+    /// The `k` nearest starts, in ascending order (`None`: all of the `used`).
+    fn nearest(&self, k: u32, used: u32) -> Option<Vec<u32>> {
+        let chosen: Vec<u32> = self
+            .by_distance
+            .iter()
+            .take(k as usize)
+            .map(|&(_, p)| p)
+            .collect();
+        unless_every(path::distinct_ascending(&chosen), used)
+    }
 }
 
 /// Which pairing of its pool the next jump takes (`None` with the exact boundary, which
