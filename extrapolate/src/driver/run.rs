@@ -127,7 +127,7 @@ impl<'a> Extrapolation<'a> {
         let snaps = (0..=used)
             .map(|index| cache::snapshot(&reader, index))
             .collect::<Result<Vec<Snapshot>, _>>()?;
-        let mut ranking = StartRanking::default();
+        let mut ranking = StartRanking::unranked();
         let targets = match &request.jumps {
             JumpStarts::Every => None,
             JumpStarts::Listed(listed) => listed_targets(request, listed, used)?,
@@ -601,7 +601,6 @@ fn unless_every(targets: Vec<u32>, used: u32) -> Option<Vec<u32>> {
 /// Every start of the recording ranked by the mean distance (diameters) of its pairing with
 /// the end `t_P'`, the recurrence norm [`JumpStarts::Nearest`] chooses by: each pairing
 /// reused or computed and stored, as the path's own are.
-#[derive(Default)]
 struct StartRanking {
     /// (mean distance, period), nearest first; ties to the earlier period.
     by_distance: Vec<(f64, u32)>,
@@ -612,6 +611,15 @@ struct StartRanking {
 }
 
 impl StartRanking {
+    /// No start ranked: no pairing computed, so none but stored ones.
+    fn unranked() -> Self {
+        Self {
+            by_distance: Vec::new(),
+            seconds: 0.0,
+            reused: true,
+        }
+    }
+
     fn of(
         request: &ExtrapolationRequest,
         reader: &RecordingReader,
@@ -620,10 +628,7 @@ impl StartRanking {
         notice: &mut impl FnMut(Notice<'_>),
     ) -> Result<Self, ExtrapolateError> {
         let end = &snaps[snaps.len() - 1];
-        let mut ranking = StartRanking {
-            reused: true,
-            ..Self::default()
-        };
+        let mut ranking = Self::unranked();
         for period in 1..snaps.len() as u32 {
             let start = &snaps[period as usize - 1];
             let stored = match cache::load(reader, start, end) {
