@@ -613,3 +613,71 @@ fn horizon_study_runs_every_p_with_each_boundary_and_its_settings() {
     // with the exact pairing alone there is nothing to name
     assert!(plain.get("boundary_maps").is_none(), "{plain}");
 }
+
+/// `tdex study horizon --jump-nearest K`: every path of the study jumps only into the K
+/// starts nearest its end, as `tdex extrapolate --jump-nearest K` does, and the study says so.
+#[test]
+fn horizon_study_jumps_to_the_nearest_starts_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, out) = tiny_horizon_study(dir.path());
+    let rec = out.join("horizon.mcap");
+    let pairs: serde_json::Value =
+        serde_json::from_str(&ok(&["pair", rec.to_str().unwrap(), "--json"])).unwrap();
+    let distance = |start: u64| {
+        pairs
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|p| p["start"] == start)
+            .unwrap()["mean_distance_diameters"]
+            .as_f64()
+            .unwrap()
+    };
+    assert_ne!(distance(0), distance(1), "the two starts tie");
+    let nearest: u32 = if distance(0) < distance(1) { 1 } else { 2 };
+
+    let near = dir.path().join("near");
+    let study = horizon_from_recording(&rec, &["--jump-nearest", "1"], &near);
+    assert_eq!(study["jump_nearest"], 1);
+    let p2 = &study["runs"].as_array().unwrap()[1];
+    assert_eq!(p2["recorded_periods"], 2);
+    let studied = Path::new(p2["extrapolation"].as_str().unwrap());
+    let info = tdex_format::ExtrapolationReader::open(studied)
+        .unwrap()
+        .info()
+        .clone();
+    match info.roles {
+        tdex_format::extrapolation::Roles::Path(path) => {
+            assert_eq!(path.jump_targets, Some(vec![nearest]))
+        }
+        other => panic!("{other:?}"),
+    }
+    let by_hand = dir.path().join("by_hand.mcap");
+    ok(&[
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "2",
+        "--periods",
+        &study["reference_periods"].to_string(),
+        "--jump-to",
+        &nearest.to_string(),
+        "-o",
+        by_hand.to_str().unwrap(),
+    ]);
+    let temperatures = |path: &Path| {
+        tdex_format::ExtrapolationReader::open(path)
+            .unwrap()
+            .snapshots()
+            .unwrap()
+            .into_iter()
+            .map(|s| s.temp)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(temperatures(&by_hand), temperatures(studied));
+    let md = std::fs::read_to_string(near.join("study.md")).unwrap();
+    assert!(
+        md.contains("jumps only into the recorded period whose start is nearest"),
+        "{md}"
+    );
+}

@@ -687,6 +687,11 @@ pub struct HorizonStudyArgs {
     /// Seed of the recurrence paths (default: the case's seed).
     #[arg(long)]
     pub seed: Option<u64>,
+    /// Every path jumps only into the K recorded periods whose start is nearest the end of
+    /// the P used (`tdex extrapolate --jump-nearest`); a P of K periods or fewer jumps as
+    /// without it.
+    #[arg(long = "jump-nearest", value_name = "K", value_parser = nearest_starts())]
+    pub jump_nearest: Option<u32>,
     /// Run every P twice: as the paper does, and with the drum's mirror image entered at
     /// every jump (`tdex extrapolate --mirror`, docs/method.md §6), so that the table says
     /// which of the two passes as one more DEM run on this case.

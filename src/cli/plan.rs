@@ -120,8 +120,8 @@ pub enum StudyKind {
         draws: Vec<PathBuf>,
         /// Distinct, ascending.
         recorded_periods: Vec<u32>,
-        /// The recurrence paths' seed; `None`: the case's.
-        seed: Option<u64>,
+        /// The recurrence paths' seed and the starts their jumps may enter.
+        jumps: crate::study::PathJumps,
         /// The images every P is run with: the paper's method, and the mirror if asked.
         images: Vec<Symmetry>,
         /// The boundary maps every P and image is run with, distinct, in the order given.
@@ -991,6 +991,7 @@ impl StudyKind {
             twins,
             tau_rev,
             seed,
+            jump_nearest,
             mirror,
             boundary,
             fresh,
@@ -1062,11 +1063,18 @@ impl StudyKind {
                 boundaries.push(maps);
             }
         }
+        let jumps = crate::study::PathJumps {
+            seed,
+            starts: jump_nearest.and_then(std::num::NonZeroU32::new).map_or(
+                extrapolate::JumpStarts::Every,
+                extrapolate::JumpStarts::Nearest,
+            ),
+        };
         Ok(StudyKind::Horizon {
             source,
             draws,
             recorded_periods,
-            seed,
+            jumps,
             images,
             boundaries,
         })

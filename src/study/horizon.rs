@@ -14,13 +14,14 @@
 //! median ratio is too noisy a figure to settle whether P passes as one more DEM run.
 
 use super::plots::{self, Line, LineKind};
+use super::PathJumps;
 use crate::cli::{HorizonSource, StudyPlan};
 use crate::compare::draws::{self, Draw, Draws};
 use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
 use extrapolate::boundary::BoundaryMaps;
-use extrapolate::{ExtrapolationRequest, MirrorCheck};
+use extrapolate::{ExtrapolationRequest, JumpStarts, MirrorCheck};
 use recorder::record;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -83,6 +84,10 @@ struct HorizonStudy {
     tau: f64,
     /// The seed of the recurrence paths (null: the case's seed, the default).
     path_seed: Option<u64>,
+    /// `--jump-nearest K`: every path jumps only into the K starts nearest its end (left
+    /// out without it: every start).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    jump_nearest: Option<u32>,
     /// What each fresh boundary map of the runs redraws, in words (left out with the exact
     /// pairing alone): the settings every draw's runs share.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -167,7 +172,7 @@ pub fn run(
     source: &HorizonSource,
     draws: &[PathBuf],
     recorded_periods: &[u32],
-    seed: Option<u64>,
+    jumps: &PathJumps,
     images: &[Symmetry],
     boundaries: &[BoundaryMaps],
 ) -> Result<()> {
@@ -193,7 +198,7 @@ pub fn run(
         // with one recording the files keep their names; with several each draw's name
         // ends them
         let draw = several.then_some(name.as_str());
-        by_draw.push(run_draw(plan, &rec, path, draw, &configurations, seed)?);
+        by_draw.push(run_draw(plan, &rec, path, draw, &configurations, jumps)?);
         info.get_or_insert_with(|| rec.info().clone());
     }
     let info = info.expect("one recording at least");
@@ -207,7 +212,11 @@ pub fn run(
         reference_periods: info.reference_periods,
         twins: info.twins,
         tau: info.tau,
-        path_seed: seed,
+        path_seed: jumps.seed,
+        jump_nearest: match jumps.starts {
+            JumpStarts::Nearest(k) => Some(k.get()),
+            JumpStarts::Every | JumpStarts::Listed(_) => None,
+        },
         boundary_maps: boundaries
             .iter()
             .filter_map(|&maps| extrapolation::boundary_settings(maps))
@@ -305,7 +314,7 @@ fn run_draw(
     path: &Path,
     draw: Option<&str>,
     configurations: &[(u32, Symmetry, BoundaryMaps)],
-    seed: Option<u64>,
+    jumps: &PathJumps,
 ) -> Result<Vec<Entry>> {
     let held = rec.info().recorded_periods;
     if let Some(&(p, ..)) = configurations.iter().find(|&&(p, ..)| p > held) {
@@ -317,7 +326,7 @@ fn run_draw(
     }
     configurations
         .iter()
-        .map(|&configuration| run_one(plan, rec, path, draw, configuration, seed))
+        .map(|&configuration| run_one(plan, rec, path, draw, configuration, jumps))
         .collect()
 }
 
@@ -330,7 +339,7 @@ fn run_one(
     path: &Path,
     draw: Option<&str>,
     (p, symmetry, maps): (u32, Symmetry, BoundaryMaps),
-    seed: Option<u64>,
+    jumps: &PathJumps,
 ) -> Result<Entry> {
     let image = match symmetry {
         Symmetry::None => "",
@@ -347,7 +356,8 @@ fn run_one(
         .join(format!("horizon_p{p}{image}{boundary}{suffix}.extra.mcap"));
     let request = ExtrapolationRequest {
         recorded_periods: Some(p),
-        path_seed: seed,
+        path_seed: jumps.seed,
+        jumps: jumps.starts.clone(),
         symmetry,
         boundary: maps,
         ..ExtrapolationRequest::new(
@@ -485,6 +495,12 @@ fn table(s: &HorizonStudy) -> String {
     }
     for settings in &s.boundary_maps {
         t += &format!("{settings}\n");
+    }
+    if let Some(k) = s.jump_nearest {
+        t += &format!(
+            "jumps: only into {} the end of the P used (the mean distance of the pairing)\n",
+            nearest_starts(k)
+        );
     }
     for e in &s.runs {
         t += &format!("{}: {}\n", e.label(), e.verdict);
@@ -644,7 +660,7 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
     format!(
         "# Long-horizon study: {}\n\n{} particles, τ = {} s; the recording `{}` holds {} \
          recorded period(s), {} reference periods and {} DEM twin(s). Each row replays the \
-         first P recorded periods along a recurrence path (seed: {}) over the {} reference \
+         first P recorded periods along a recurrence path (seed: {}{}) over the {} reference \
          periods (`mirror`: entering the drum's mirror image at every jump) and compares it \
          with the DEM and its twins at every t_k (200 Voronoi cells \
          unless `--cells` says otherwise). ratio: the extrapolation's mean cell distance to \
@@ -663,6 +679,10 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
         s.twins,
         s.path_seed
             .map_or("the case's".to_string(), |x| x.to_string()),
+        s.jump_nearest.map_or(String::new(), |k| format!(
+            "; jumps only into {} the end of the P used",
+            nearest_starts(k)
+        )),
         s.reference_periods,
     )
 }
@@ -779,6 +799,15 @@ fn svgs(s: &HorizonStudy) -> Result<Vec<(&'static str, String)>> {
         None,
     )?;
     Ok(vec![("ratio.svg", ratio), ("means.svg", means)])
+}
+
+/// `--jump-nearest K` in words: the recorded periods a path may enter.
+fn nearest_starts(k: u32) -> String {
+    if k == 1 {
+        "the recorded period whose start is nearest".into()
+    } else {
+        format!("the {k} recorded periods whose starts are nearest")
+    }
 }
 
 #[cfg(test)]

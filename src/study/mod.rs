@@ -20,6 +20,14 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tdex_format::{ExtrapolationReader, RecordingReader};
 
+/// How a horizon study's recurrence paths jump: their seed (`None`: the case's) and the
+/// starts they may enter.
+#[derive(Debug, Clone)]
+pub struct PathJumps {
+    pub seed: Option<u64>,
+    pub starts: extrapolate::JumpStarts,
+}
+
 pub fn run(plan: &StudyPlan) -> Result<()> {
     tdex_format::output::create_dir_all(&plan.output)?;
     match &plan.kind {
@@ -38,7 +46,7 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
             source,
             draws,
             recorded_periods,
-            seed,
+            jumps,
             images,
             boundaries,
         } => horizon::run(
@@ -46,7 +54,7 @@ pub fn run(plan: &StudyPlan) -> Result<()> {
             source,
             draws,
             recorded_periods,
-            *seed,
+            jumps,
             images,
             boundaries,
         ),
