@@ -323,6 +323,17 @@ fn bad_study_flags_exit_2_naming_the_flag() {
     );
 }
 
+/// Every snapshot's temperatures of the extrapolation at `path`, in order.
+fn temperatures(path: &Path) -> Vec<Vec<f64>> {
+    tdex_format::ExtrapolationReader::open(path)
+        .unwrap()
+        .snapshots()
+        .unwrap()
+        .into_iter()
+        .map(|s| s.temp)
+        .collect()
+}
+
 /// `tdex study horizon REC --recorded-periods 1,2 FLAGS --json -o OUT`, its JSON.
 fn horizon_from_recording(rec: &Path, flags: &[&str], out: &Path) -> serde_json::Value {
     let mut args = vec![
@@ -555,16 +566,7 @@ fn horizon_study_runs_every_p_with_each_boundary_and_its_settings() {
         studied.ends_with("horizon_p2_fresh-steps.extra.mcap"),
         "{studied}"
     );
-    let snapshots = |path: &Path| {
-        tdex_format::ExtrapolationReader::open(path)
-            .unwrap()
-            .snapshots()
-            .unwrap()
-            .into_iter()
-            .map(|s| s.temp)
-            .collect::<Vec<_>>()
-    };
-    assert_eq!(snapshots(&steps), snapshots(Path::new(studied)));
+    assert_eq!(temperatures(&steps), temperatures(Path::new(studied)));
     let md = std::fs::read_to_string(fresh.join("study.md")).unwrap();
     assert!(md.contains("P = 2, fresh steps"), "{md}");
 
@@ -665,15 +667,6 @@ fn horizon_study_jumps_to_the_nearest_starts_when_asked() {
         "-o",
         by_hand.to_str().unwrap(),
     ]);
-    let temperatures = |path: &Path| {
-        tdex_format::ExtrapolationReader::open(path)
-            .unwrap()
-            .snapshots()
-            .unwrap()
-            .into_iter()
-            .map(|s| s.temp)
-            .collect::<Vec<_>>()
-    };
     assert_eq!(temperatures(&by_hand), temperatures(studied));
     let md = std::fs::read_to_string(near.join("study.md")).unwrap();
     assert!(
