@@ -297,9 +297,8 @@ impl<'a> Extrapolation<'a> {
         Ok(mirror_check)
     }
 
-    /// Computes the pairing of the end snapshot to the start of recorded period `period` (its
-    /// image under `symmetry`) and stores it beside the recording; the stored pairing only
-    /// saves time next run, so a recording on a full or read-only disk is still extrapolated.
+    /// Computes and stores the pairing of the end snapshot to the start of recorded period
+    /// `period` (its image under `symmetry`), timed with the run's pairings.
     fn compute_and_store(
         &mut self,
         period: u32,
@@ -308,15 +307,14 @@ impl<'a> Extrapolation<'a> {
     ) -> Result<StoredPairing, ExtrapolateError> {
         let started = Instant::now();
         let start = start_image(&self.snaps, period, symmetry);
-        let end = self.end();
-        let mut stored = cache::compute(&start, end, axial_period(&self.info))?;
-        if self.request.reproducible {
-            stored.summary = stored.summary.reproducible();
-        }
-        if let Err(e) = cache::store_image(&self.reader, end.index, start.index, symmetry, &stored)
-        {
-            notice(Notice::PairingNotStored(&e));
-        }
+        let stored = pair_and_store(
+            &self.reader,
+            &self.info,
+            self.request.reproducible,
+            (&start, self.end()),
+            symmetry,
+            notice,
+        )?;
         self.seconds_pairing += started.elapsed().as_secs_f64();
         Ok(stored)
     }
@@ -610,6 +608,27 @@ struct StartRanking {
     reused: bool,
 }
 
+/// Computes the pairing of `end` to `start` (a start, or its image under `symmetry`) and
+/// stores it beside the recording; the stored pairing only saves time next run, so a
+/// recording on a full or read-only disk is still extrapolated.
+fn pair_and_store(
+    reader: &RecordingReader,
+    info: &RecordingInfo,
+    reproducible: bool,
+    (start, end): (&Snapshot, &Snapshot),
+    symmetry: Symmetry,
+    notice: &mut impl FnMut(Notice<'_>),
+) -> Result<StoredPairing, ExtrapolateError> {
+    let mut stored = cache::compute(start, end, axial_period(info))?;
+    if reproducible {
+        stored.summary = stored.summary.reproducible();
+    }
+    if let Err(e) = cache::store_image(reader, end.index, start.index, symmetry, &stored) {
+        notice(Notice::PairingNotStored(&e));
+    }
+    Ok(stored)
+}
+
 impl StartRanking {
     /// No start ranked: no pairing computed, so none but stored ones.
     fn unranked() -> Self {
@@ -635,15 +654,14 @@ impl StartRanking {
                 Some(stored) => stored,
                 None => {
                     let started = Instant::now();
-                    let mut stored = cache::compute(start, end, axial_period(info))?;
-                    if request.reproducible {
-                        stored.summary = stored.summary.reproducible();
-                    }
-                    if let Err(e) =
-                        cache::store_image(reader, end.index, start.index, Symmetry::None, &stored)
-                    {
-                        notice(Notice::PairingNotStored(&e));
-                    }
+                    let stored = pair_and_store(
+                        reader,
+                        info,
+                        request.reproducible,
+                        (start, end),
+                        Symmetry::None,
+                        notice,
+                    )?;
                     ranking.seconds += started.elapsed().as_secs_f64();
                     ranking.reused = false;
                     stored
