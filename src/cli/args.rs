@@ -232,7 +232,7 @@ pub struct ExtrapolateArgs {
         conflicts_with = "jump_to",
         value_parser = nearest_starts()
     )]
-    pub jump_nearest: Option<u32>,
+    pub jump_nearest: Option<std::num::NonZeroU32>,
     /// Use the drum's mirror symmetry (its mid-plane y = 0): every jump enters the mirror
     /// image of the recorded start, so the periods replayed alternate between the recording
     /// and its mirror image (docs/method.md §6). Costs one more pairing per start; needs a
@@ -691,7 +691,7 @@ pub struct HorizonStudyArgs {
     /// the P used (`tdex extrapolate --jump-nearest`); a P of K periods or fewer jumps as
     /// without it.
     #[arg(long = "jump-nearest", value_name = "K", value_parser = nearest_starts())]
-    pub jump_nearest: Option<u32>,
+    pub jump_nearest: Option<std::num::NonZeroU32>,
     /// Run every P twice: as the paper does, and with the drum's mirror image entered at
     /// every jump (`tdex extrapolate --mirror`, docs/method.md §6), so that the table says
     /// which of the two passes as one more DEM run on this case.
@@ -765,9 +765,11 @@ fn periods_used() -> super::values::Count<u32> {
     count(1, "a whole number", "use at least 1 recorded period")
 }
 
-/// `tdex extrapolate --jump-nearest`: at least one start.
-fn nearest_starts() -> super::values::Count<u32> {
-    count(1, "a whole number", "give at least 1 start to jump to")
+/// `tdex extrapolate --jump-nearest`: at least one start, so never zero.
+fn nearest_starts() -> impl clap::builder::TypedValueParser<Value = std::num::NonZeroU32> {
+    use clap::builder::TypedValueParser;
+    count::<u32>(1, "a whole number", "give at least 1 start to jump to")
+        .try_map(std::num::NonZeroU32::try_from)
 }
 
 /// `tdex extrapolate --boundary-pool`: at least one pairing.

@@ -446,10 +446,7 @@ impl ExtrapolatePlan {
             seed: args.seed,
             jumps: match (args.jump_to, args.jump_nearest) {
                 (Some(listed), _) => extrapolate::JumpStarts::Listed(listed),
-                (None, Some(k)) => std::num::NonZeroU32::new(k).map_or(
-                    extrapolate::JumpStarts::Every,
-                    extrapolate::JumpStarts::Nearest,
-                ),
+                (None, Some(k)) => extrapolate::JumpStarts::Nearest(k),
                 (None, None) => extrapolate::JumpStarts::Every,
             },
             symmetry: if args.mirror {
@@ -1065,7 +1062,7 @@ impl StudyKind {
         }
         let jumps = crate::study::PathJumps {
             seed,
-            starts: jump_nearest.and_then(std::num::NonZeroU32::new).map_or(
+            starts: jump_nearest.map_or(
                 extrapolate::JumpStarts::Every,
                 extrapolate::JumpStarts::Nearest,
             ),
