@@ -4,7 +4,7 @@
 
 use crate::cli_checkpoint::{checkpoint_of, kill_at, resume_to_the_end, spawn};
 use crate::cli_run::TINY_CASE;
-use crate::util::{run_tdex, tdex_ok};
+use crate::util::{extrapolated, run_tdex, tdex_ok};
 use std::path::{Path, PathBuf};
 use tdex_format::{CollisionRow, RecordingReader};
 
@@ -241,14 +241,6 @@ fn recorded_periods_outside_1_to_64_are_refused() {
     ]);
     assert_eq!(o.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
-}
-
-/// The extrapolated snapshots of `path`, by index.
-fn extrapolated(path: &Path) -> Vec<tdex_format::Snapshot> {
-    tdex_format::ExtrapolationReader::open(path)
-        .unwrap()
-        .snapshots()
-        .unwrap()
 }
 
 /// `tdex compare rec x --cells 20 --json`.

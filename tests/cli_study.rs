@@ -325,13 +325,7 @@ fn bad_study_flags_exit_2_naming_the_flag() {
 
 /// Every snapshot's temperatures of the extrapolation at `path`, in order.
 fn temperatures(path: &Path) -> Vec<Vec<f64>> {
-    tdex_format::ExtrapolationReader::open(path)
-        .unwrap()
-        .snapshots()
-        .unwrap()
-        .into_iter()
-        .map(|s| s.temp)
-        .collect()
+    extrapolated(path).into_iter().map(|s| s.temp).collect()
 }
 
 /// `tdex study horizon REC --recorded-periods 1,2 FLAGS --json -o OUT`, its JSON.

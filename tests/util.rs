@@ -206,3 +206,11 @@ pub fn liggghts_available() -> bool {
     }
     found
 }
+
+/// The extrapolated snapshots of the extrapolation at `path`, by index.
+pub fn extrapolated(path: &Path) -> Vec<tdex_format::Snapshot> {
+    tdex_format::ExtrapolationReader::open(path)
+        .unwrap()
+        .snapshots()
+        .unwrap()
+}
