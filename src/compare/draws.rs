@@ -100,6 +100,11 @@ pub struct Draw {
     /// runs' in the seat; null otherwise (left out of the JSON).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pattern: Option<Beside<f64>>,
+    /// The median ratio over the last fifth of the compared `t_k`
+    /// ([`super::verdict::LateVerdict`]), the extrapolation's beside the mean of the DEM
+    /// runs'; null where the horizon is too short to tell (left out of the JSON).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub late: Option<Beside<f64>>,
     /// Whether the means are the hot and cold group means (else the bed mean).
     #[serde(skip)]
     pub groups: bool,
@@ -155,6 +160,12 @@ impl Draw {
                 Some(Beside {
                     extrapolation: p.median_ratio,
                     dem_run: mean(&p.dem_runs_median_ratio)?,
+                })
+            }),
+            late: v.late.as_ref().and_then(|l| {
+                Some(Beside {
+                    extrapolation: l.median_ratio,
+                    dem_run: mean(&l.dem_runs_median_ratio)?,
                 })
             }),
             groups: c.contrast == ContrastKind::HotCold,
@@ -214,6 +225,12 @@ pub struct Draws {
     /// miss in the bed mean from one in where the heat is.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pattern: Option<Beside<MeanSe>>,
+    /// The median ratio over the last fifth of each draw's compared `t_k`, over the draws,
+    /// the extrapolation's beside a DEM run's in the seat (null unless every draw has it,
+    /// and then left out of the JSON). Not part of the judgement: a late mean above the whole
+    /// horizon's, a DEM run's not, says the error is still growing where the horizon ends.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub late: Option<Beside<MeanSe>>,
     /// Each draw's figures, in the order given.
     pub each: Vec<Draw>,
     /// The judgement in words.
@@ -269,6 +286,12 @@ impl Draws {
                 dem_run: over_some(|d| d.pattern.map(|p| p.dem_run))?,
             })
         });
+        let late = over_some(|d| d.late.map(|l| l.extrapolation)).and_then(|x| {
+            Some(Beside {
+                extrapolation: x,
+                dem_run: over_some(|d| d.late.map(|l| l.dem_run))?,
+            })
+        });
         let passes = median_ratio_within && outside_share_within && means_within_spread;
         let mut pooled = Draws {
             draws: each.len(),
@@ -290,6 +313,7 @@ impl Draws {
             means_error_to_spread,
             dem_runs_means_error_to_spread,
             pattern,
+            late,
             each,
             text: String::new(),
         };
@@ -377,9 +401,17 @@ impl Draws {
                 plus_minus(p.dem_run)
             )
         });
+        let late_words = self.late.map_or(String::new(), |l| {
+            format!(
+                "; over the last fifth of each draw's compared t_k: mean median ratio {} \
+                 against {} for a DEM run",
+                plus_minus(l.extrapolation),
+                plus_minus(l.dem_run)
+            )
+        });
         format!(
             "{} as one more DEM run over the {n} draws: {ratio_words}; {outside_words}; \
-             {means_words}{pattern_words}",
+             {means_words}{pattern_words}{late_words}",
             if self.passes {
                 "passes"
             } else {
@@ -429,6 +461,14 @@ impl Draws {
                 "median ratio less the bed mean",
                 plus_minus(p.extrapolation),
                 plus_minus(p.dem_run)
+            );
+        }
+        if let Some(l) = self.late {
+            s += &format!(
+                "{:<40} {:>16} {:>20}\n",
+                "median ratio, last fifth of the t_k",
+                plus_minus(l.extrapolation),
+                plus_minus(l.dem_run)
             );
         }
         s
@@ -526,6 +566,7 @@ mod tests {
             means_error_to_spread: Some(0.5),
             dem_runs_means_error_to_spread: Some(0.5),
             pattern: None,
+            late: None,
             groups: true,
         }
     }
@@ -727,6 +768,43 @@ mod tests {
         assert_eq!(pooled.pattern, None);
         assert!(!pooled.text.contains("less its own bed mean"));
         assert!(!pooled.table().contains("less the bed mean"));
+    }
+
+    #[test]
+    fn the_last_fifth_is_pooled_beside_a_dem_runs_where_every_draw_has_it_and_does_not_judge() {
+        let growing = |late: f64| Draw {
+            late: Some(Beside {
+                extrapolation: late,
+                dem_run: 1.0,
+            }),
+            ..draw(1.0, 0.3, 1.0, 0.3)
+        };
+        let draws = vec![growing(1.2), growing(1.4), growing(1.3)];
+        let pooled = Draws::pool(draws.clone()).unwrap();
+        let late = pooled.late.unwrap();
+        assert!((late.extrapolation.mean - 1.3).abs() < 1e-12, "{late:?}");
+        assert!((late.extrapolation.standard_error - 0.1 / 3f64.sqrt()).abs() < 1e-12);
+        assert_eq!(late.dem_run.mean, 1.0);
+        // the whole horizon decides: it passes, whatever its last fifth
+        assert!(pooled.passes, "{}", pooled.text);
+        assert!(
+            pooled.text.ends_with(
+                "; over the last fifth of each draw's compared t_k: mean median ratio 1.30 ± 0.06 \
+                 against 1.00 ± 0.00 for a DEM run"
+            ),
+            "{}",
+            pooled.text
+        );
+        assert!(pooled
+            .table()
+            .contains("median ratio, last fifth of the t_k"));
+        // a draw whose horizon is too short to tell: nothing pooled, nothing said
+        let mut mixed = draws;
+        mixed[2].late = None;
+        let pooled = Draws::pool(mixed).unwrap();
+        assert_eq!(pooled.late, None);
+        assert!(!pooled.text.contains("last fifth"));
+        assert!(!pooled.table().contains("last fifth"));
     }
 
     #[test]

@@ -97,8 +97,60 @@ pub struct Verdict {
     /// is in the bed mean or in where the heat is.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub pattern: Option<PatternVerdict>,
+    /// The medians over the last fifth of the compared `t_k`, beside each DEM run's: whether
+    /// the error is still growing where the horizon ends. Not part of the judgement; null
+    /// (left out of the JSON) with fewer than three DEM runs or [`LATE_LEAST_COMPARED`]
+    /// compared `t_k`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub late: Option<LateVerdict>,
     /// The verdict in words.
     pub text: String,
+}
+
+/// The compared `t_k` a horizon needs for its last fifth to be told: ten of them in it, so
+/// that its median is not one instant's.
+pub const LATE_LEAST_COMPARED: usize = 50;
+
+/// The median ratio over the last fifth of the compared `t_k`. A replay whose per-period
+/// errors add up strays more the longer it runs, while a DEM run's distance to the others
+/// stays the same in law: a late median above the whole horizon's, with the DEM runs' not,
+/// says a longer horizon will be farther off than the verdict's.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LateVerdict {
+    /// The first and last `k` of the last fifth.
+    pub first: u32,
+    pub last: u32,
+    pub median_ratio: f64,
+    /// Each DEM run's, judged against the others over the same `t_k`.
+    pub dem_runs_median_ratio: Vec<f64>,
+}
+
+impl LateVerdict {
+    /// Over the last fifth of `compared` (the `t_k` with a ratio, in order) of `periods`;
+    /// `None` with fewer than three DEM runs or [`LATE_LEAST_COMPARED`] compared `t_k`.
+    fn of(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize) -> Option<Self> {
+        if dem_runs < 3 || compared.len() < LATE_LEAST_COMPARED {
+            return None;
+        }
+        let late = &compared[compared.len() - compared.len() / 5..];
+        let ratios: Vec<f64> = periods
+            .iter()
+            .filter(|p| late.contains(&p.k))
+            .filter_map(|p| p.ratio_to_floor)
+            .collect();
+        let dem_runs_median_ratio = runs_medians(periods, late, dem_runs, |p| {
+            Some(&p.dem_runs_ratio_to_others)
+        });
+        if dem_runs_median_ratio.is_empty() {
+            return None;
+        }
+        Some(Self {
+            first: *late.first()?,
+            last: *late.last()?,
+            median_ratio: median(&ratios)?,
+            dem_runs_median_ratio,
+        })
+    }
 }
 
 /// The median ratio of each field less its own bed mean, over the compared `t_k`.
@@ -260,6 +312,7 @@ impl Verdict {
             Some(&p.dem_runs_ratio_to_others)
         });
         let pattern = PatternVerdict::of(&periods, &compared, dem_runs);
+        let late = LateVerdict::of(&periods, &compared, dem_runs);
         let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
             Vec::new()
         } else {
@@ -293,6 +346,7 @@ impl Verdict {
             means_in_seat,
             dem_runs_means,
             pattern,
+            late,
             text: String::new(),
         };
         verdict.text = verdict.words(&setting);
@@ -323,6 +377,7 @@ impl Verdict {
             self.left_out_words(),
             self.means_words(setting),
             self.pattern_words(),
+            self.late_words(),
             self.runs_note(setting),
         ]
         .concat()
@@ -462,6 +517,24 @@ impl Verdict {
             "; each field less its own bed mean (where the heat is, apart from how fast the bed \
              heats): median ratio {}{dem}",
             beside_one(p.median_ratio)
+        )
+    }
+
+    /// The last fifth of the horizon beside the DEM runs' over it, where there is one.
+    fn late_words(&self) -> String {
+        let Some(l) = &self.late else {
+            return String::new();
+        };
+        let Some((lo, hi)) = min_max(l.dem_runs_median_ratio.iter().copied()) else {
+            return String::new();
+        };
+        format!(
+            "; over the last fifth, t{}…t{}: median ratio {}, each DEM run's {}–{}",
+            l.first,
+            l.last,
+            beside_one(l.median_ratio),
+            num(lo),
+            num(hi)
         )
     }
 
@@ -890,6 +963,55 @@ mod tests {
         assert!(v.dem_runs_median_ratio.is_empty());
         assert!(v.dem_runs_outside_share.is_empty());
         assert!(!v.text.contains("each DEM run"), "{}", v.text);
+    }
+
+    /// A replay that strays more the longer it runs: its median over the last fifth of the
+    /// compared t_k stands beside each DEM run's there, told apart from the whole
+    /// horizon's; a horizon too short for ten t_k in its last fifth, or fewer than three
+    /// runs, gives none.
+    #[test]
+    fn the_last_fifth_of_the_horizon_is_told_beside_the_dem_runs() {
+        let late_periods = |n: usize| -> Vec<PeriodComparison> {
+            (0..n)
+                .map(|i| {
+                    // 1.0 over the first four fifths, 1.5 over the last
+                    let growing = if i >= n - n / 5 { 1.5 } else { 1.0 };
+                    let mut p = period(2 + i as u32, growing, 2.0);
+                    p.dem_runs_ratio_to_others = vec![Some(0.9), Some(1.0), Some(1.1)];
+                    p.dem_runs_outside_others_range = vec![false; 3];
+                    p
+                })
+                .collect()
+        };
+        let periods = late_periods(60);
+        let v = Verdict::of(&periods, 3, Departure::WithTheTwins, ContrastKind::HotCold);
+        assert_eq!(v.median_ratio, Some(1.0));
+        let late = v.late.as_ref().expect("60 compared t_k and three runs");
+        // the last 12 of t2…t61
+        assert_eq!((late.first, late.last), (50, 61));
+        assert_eq!(late.median_ratio, 1.5);
+        assert_eq!(late.dem_runs_median_ratio, vec![0.9, 1.0, 1.1]);
+        assert!(
+            v.text.contains(
+                "; over the last fifth, t50…t61: median ratio 1.50, each DEM run's 0.9–1.1"
+            ),
+            "{}",
+            v.text
+        );
+        // 49 compared t_k: too few to tell
+        let v = Verdict::of(
+            &late_periods(49),
+            3,
+            Departure::WithTheTwins,
+            ContrastKind::HotCold,
+        );
+        assert_eq!(v.late, None);
+        assert!(!v.text.contains("last fifth"), "{}", v.text);
+        // two runs: no DEM run to judge in the seat
+        let v = Verdict::of(&periods, 2, Departure::WithTheTwins, ContrastKind::HotCold);
+        assert_eq!(v.late, None);
+        let json = serde_json::to_string(&v).unwrap();
+        assert!(!json.contains("late"), "{json}");
     }
 
     /// Each DEM run is judged on the means as the second field is: its error against the

@@ -614,6 +614,25 @@ fn pooled_table(s: &HorizonStudy) -> String {
             );
         }
     }
+    // a horizon long enough to tell its last fifth: whether the error is still growing
+    if s.pooled.iter().any(|r| r.draws.late.is_some()) {
+        t += "\nthe last fifth of each draw's compared t_k, over the draws (where the horizon \
+              ends: above the whole horizon's median, the error still grows, and a longer \
+              horizon will be farther off; it informs, the verdict is on the whole horizon):\n";
+        t += &format!(
+            "{:<w$} {:>14} {:>22}\n",
+            "run", "median ratio", "DEM run: median ratio"
+        );
+        for r in &s.pooled {
+            let d = &r.draws;
+            t += &format!(
+                "{:<w$} {:>14} {:>22}\n",
+                r.label(),
+                or_dash(d.late.map(|l| l.extrapolation)),
+                or_dash(d.late.map(|l| l.dem_run)),
+            );
+        }
+    }
     t.push('\n');
     for r in &s.pooled {
         t += &format!("{} over the draws: {}\n", r.label(), r.draws.text);
