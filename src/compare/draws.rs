@@ -422,54 +422,51 @@ impl Draws {
 
     /// The pooled figures as a small table: the extrapolation beside a DEM run in the seat.
     pub fn table(&self) -> String {
-        let mut s = format!(
-            "{:<40} {:>16} {:>20}\n",
-            "over the draws (mean ± SE)", "extrapolation", "DEM run in the seat"
+        let line = |label: &str, extrapolation: String, dem_run: String| {
+            format!("{label:<40} {extrapolation:>16} {dem_run:>20}\n")
+        };
+        let beside = |label: &str, b: Beside<MeanSe>| {
+            line(label, plus_minus(b.extrapolation), plus_minus(b.dem_run))
+        };
+        let mut s = line(
+            "over the draws (mean ± SE)",
+            "extrapolation".into(),
+            "DEM run in the seat".into(),
         );
-        s += &format!(
-            "{:<40} {:>16} {:>20}\n",
+        s += &beside(
             "median ratio",
-            plus_minus(self.median_ratio),
-            plus_minus(self.dem_runs_median_ratio)
+            Beside {
+                extrapolation: self.median_ratio,
+                dem_run: self.dem_runs_median_ratio,
+            },
         );
-        s += &format!(
-            "{:<40} {:>16} {:>20}\n",
+        s += &line(
             "beyond the DEM runs' range (% t_k)",
             percent_plus_minus(self.outside_share),
-            percent_plus_minus(self.dem_runs_outside_share)
+            percent_plus_minus(self.dem_runs_outside_share),
         );
-        s += &format!(
-            "{:<40} {:>16} {:>20}\n",
+        s += &line(
             "means beyond the others' spread (% seats)",
             percent_plus_minus(self.means_outside_share_in_seat),
-            percent_plus_minus(self.dem_runs_means_outside_share)
+            percent_plus_minus(self.dem_runs_means_outside_share),
         );
-        if let (Some(x), Some(dem)) = (
+        if let (Some(extrapolation), Some(dem_run)) = (
             self.means_error_to_spread,
             self.dem_runs_means_error_to_spread,
         ) {
-            s += &format!(
-                "{:<40} {:>16} {:>20}\n",
+            s += &beside(
                 "means: largest error / others' spread",
-                plus_minus(x),
-                plus_minus(dem)
+                Beside {
+                    extrapolation,
+                    dem_run,
+                },
             );
         }
         if let Some(p) = self.pattern {
-            s += &format!(
-                "{:<40} {:>16} {:>20}\n",
-                "median ratio less the bed mean",
-                plus_minus(p.extrapolation),
-                plus_minus(p.dem_run)
-            );
+            s += &beside("median ratio less the bed mean", p);
         }
         if let Some(l) = self.late {
-            s += &format!(
-                "{:<40} {:>16} {:>20}\n",
-                "median ratio, last fifth of the t_k",
-                plus_minus(l.extrapolation),
-                plus_minus(l.dem_run)
-            );
+            s += &beside("median ratio, last fifth of the t_k", l);
         }
         s
     }

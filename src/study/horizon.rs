@@ -597,42 +597,22 @@ fn pooled_table(s: &HorizonStudy) -> String {
         );
     }
     // a bed heated through a wall: the same medians on each field less its own bed mean
-    if s.pooled.iter().any(|r| r.draws.pattern.is_some()) {
-        t += "\neach field less its own bed mean, over the draws (where the heat is, apart from \
-              how fast the bed heats; it informs, the verdict is on the field):\n";
-        t += &format!(
-            "{:<w$} {:>14} {:>22}\n",
-            "run", "median ratio", "DEM run: median ratio"
-        );
-        for r in &s.pooled {
-            let d = &r.draws;
-            t += &format!(
-                "{:<w$} {:>14} {:>22}\n",
-                r.label(),
-                or_dash(d.pattern.map(|p| p.extrapolation)),
-                or_dash(d.pattern.map(|p| p.dem_run)),
-            );
-        }
-    }
+    t += &beside_table(
+        s,
+        w,
+        "each field less its own bed mean, over the draws (where the heat is, apart from how \
+         fast the bed heats; it informs, the verdict is on the field)",
+        |d| d.pattern,
+    );
     // a horizon long enough to tell its last fifth: whether the error is still growing
-    if s.pooled.iter().any(|r| r.draws.late.is_some()) {
-        t += "\nthe last fifth of each draw's compared t_k, over the draws (where the horizon \
-              ends: above the whole horizon's median, the error still grows, and a longer \
-              horizon will be farther off; it informs, the verdict is on the whole horizon):\n";
-        t += &format!(
-            "{:<w$} {:>14} {:>22}\n",
-            "run", "median ratio", "DEM run: median ratio"
-        );
-        for r in &s.pooled {
-            let d = &r.draws;
-            t += &format!(
-                "{:<w$} {:>14} {:>22}\n",
-                r.label(),
-                or_dash(d.late.map(|l| l.extrapolation)),
-                or_dash(d.late.map(|l| l.dem_run)),
-            );
-        }
-    }
+    t += &beside_table(
+        s,
+        w,
+        "the last fifth of each draw's compared t_k, over the draws (where the horizon ends: \
+         above the whole horizon's median, the error still grows, and a longer horizon will be \
+         farther off; it informs, the verdict is on the whole horizon)",
+        |d| d.late,
+    );
     t.push('\n');
     for r in &s.pooled {
         t += &format!("{} over the draws: {}\n", r.label(), r.draws.text);
@@ -647,6 +627,34 @@ fn pooled_table(s: &HorizonStudy) -> String {
             "closest to one more DEM run over the draws: {} (mean median ratio {})\n",
             best.label(),
             draws::plus_minus(best.draws.median_ratio)
+        );
+    }
+    t
+}
+
+/// A median ratio the pooled verdict informs by and does not judge on, per row, the
+/// extrapolation's beside a DEM run's; nothing where no row has it.
+fn beside_table(
+    s: &HorizonStudy,
+    w: usize,
+    heading: &str,
+    figure: impl Fn(&draws::Draws) -> Option<draws::Beside<draws::MeanSe>>,
+) -> String {
+    if s.pooled.iter().all(|r| figure(&r.draws).is_none()) {
+        return String::new();
+    }
+    let or_dash = |m: Option<draws::MeanSe>| m.map_or("-".to_string(), draws::plus_minus);
+    let mut t = format!(
+        "\n{heading}:\n{:<w$} {:>14} {:>22}\n",
+        "run", "median ratio", "DEM run: median ratio"
+    );
+    for r in &s.pooled {
+        let beside = figure(&r.draws);
+        t += &format!(
+            "{:<w$} {:>14} {:>22}\n",
+            r.label(),
+            or_dash(beside.map(|b| b.extrapolation)),
+            or_dash(beside.map(|b| b.dem_run)),
         );
     }
     t
