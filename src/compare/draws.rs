@@ -156,18 +156,14 @@ impl Draw {
                 .ok_or_else(not_judged)?,
             means_error_to_spread: error_to_spread(&v.means_in_seat),
             dem_runs_means_error_to_spread: error_to_spread(&v.dem_runs_means),
-            pattern: v.pattern.as_ref().and_then(|p| {
-                Some(Beside {
-                    extrapolation: p.median_ratio,
-                    dem_run: mean(&p.dem_runs_median_ratio)?,
-                })
-            }),
-            late: v.late.as_ref().and_then(|l| {
-                Some(Beside {
-                    extrapolation: l.median_ratio,
-                    dem_run: mean(&l.dem_runs_median_ratio)?,
-                })
-            }),
+            pattern: v
+                .pattern
+                .as_ref()
+                .and_then(|p| beside_runs(p.median_ratio, &p.dem_runs_median_ratio)),
+            late: v
+                .late
+                .as_ref()
+                .and_then(|l| beside_runs(l.median_ratio, &l.dem_runs_median_ratio)),
             groups: c.contrast == ContrastKind::HotCold,
         })
     }
@@ -181,6 +177,14 @@ impl Draw {
         };
         !means.outside()
     }
+}
+
+/// A median ratio beside the mean of the DEM runs' in the seat; `None` without runs.
+fn beside_runs(median_ratio: f64, dem_runs_median_ratio: &[f64]) -> Option<Beside<f64>> {
+    (!dem_runs_median_ratio.is_empty()).then(|| Beside {
+        extrapolation: median_ratio,
+        dem_run: dem_runs_median_ratio.iter().sum::<f64>() / dem_runs_median_ratio.len() as f64,
+    })
 }
 
 /// The pooled judgement over several draws of one case.
@@ -280,18 +284,18 @@ impl Draws {
         };
         let means_error_to_spread = over_some(|d| d.means_error_to_spread);
         let dem_runs_means_error_to_spread = over_some(|d| d.dem_runs_means_error_to_spread);
-        let pattern = over_some(|d| d.pattern.map(|p| p.extrapolation)).and_then(|x| {
+        // a figure that informs: pooled only where every draw has it
+        let over_beside = |figure: fn(&Draw) -> Option<Beside<f64>>| {
+            let values = each.iter().map(figure).collect::<Option<Vec<_>>>()?;
+            let (x, dem): (Vec<f64>, Vec<f64>) =
+                values.iter().map(|b| (b.extrapolation, b.dem_run)).unzip();
             Some(Beside {
-                extrapolation: x,
-                dem_run: over_some(|d| d.pattern.map(|p| p.dem_run))?,
+                extrapolation: MeanSe::of(&x)?,
+                dem_run: MeanSe::of(&dem)?,
             })
-        });
-        let late = over_some(|d| d.late.map(|l| l.extrapolation)).and_then(|x| {
-            Some(Beside {
-                extrapolation: x,
-                dem_run: over_some(|d| d.late.map(|l| l.dem_run))?,
-            })
-        });
+        };
+        let pattern = over_beside(|d| d.pattern);
+        let late = over_beside(|d| d.late);
         let passes = median_ratio_within && outside_share_within && means_within_spread;
         let mut pooled = Draws {
             draws: each.len(),

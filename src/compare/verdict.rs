@@ -126,18 +126,20 @@ pub struct LateVerdict {
 }
 
 impl LateVerdict {
-    /// Over the last fifth of `compared` (the `t_k` with a ratio, in order) of `periods`;
+    /// Over the last fifth of `compared` (the `t_k` with a ratio, in order, and `ratios`
+    /// theirs) of `periods`;
     /// `None` with fewer than three DEM runs or [`LATE_LEAST_COMPARED`] compared `t_k`.
-    fn of(periods: &[&PeriodComparison], compared: &[u32], dem_runs: usize) -> Option<Self> {
+    fn of(
+        periods: &[&PeriodComparison],
+        compared: &[u32],
+        ratios: &[f64],
+        dem_runs: usize,
+    ) -> Option<Self> {
         if dem_runs < 3 || compared.len() < LATE_LEAST_COMPARED {
             return None;
         }
-        let late = &compared[compared.len() - compared.len() / 5..];
-        let ratios: Vec<f64> = periods
-            .iter()
-            .filter(|p| late.contains(&p.k))
-            .filter_map(|p| p.ratio_to_floor)
-            .collect();
+        let start = compared.len() - compared.len() / 5;
+        let late = &compared[start..];
         let dem_runs_median_ratio = runs_medians(periods, late, dem_runs, |p| {
             Some(&p.dem_runs_ratio_to_others)
         });
@@ -147,7 +149,7 @@ impl LateVerdict {
         Some(Self {
             first: *late.first()?,
             last: *late.last()?,
-            median_ratio: median(&ratios)?,
+            median_ratio: median(&ratios[start..])?,
             dem_runs_median_ratio,
         })
     }
@@ -312,7 +314,7 @@ impl Verdict {
             Some(&p.dem_runs_ratio_to_others)
         });
         let pattern = PatternVerdict::of(&periods, &compared, dem_runs);
-        let late = LateVerdict::of(&periods, &compared, dem_runs);
+        let late = LateVerdict::of(&periods, &compared, &ratios, dem_runs);
         let dem_runs_outside_share = if dem_runs_median_ratio.is_empty() {
             Vec::new()
         } else {
