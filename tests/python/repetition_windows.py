@@ -24,6 +24,8 @@ import statistics
 import subprocess
 import sys
 
+from beds_summary import mean_se
+
 R_WINDOWS = [(1, 3), (3, 6), (6, 9), (9, 12), (12, 18), (18, 25), (25, 40), (40, 80)]
 
 
@@ -50,10 +52,10 @@ def k_windows(first, last):
     return list(zip(edges[:-1], edges[1:]))
 
 
-def mean_se(xs):
+def mean_se_text(xs):
     if len(xs) < 2:
         return f"{xs[0]:.2f}" if xs else "-"
-    return f"{statistics.mean(xs):.2f} ± {statistics.stdev(xs) / len(xs) ** 0.5:.2f}"
+    return "%.2f ± %.2f" % mean_se(xs)
 
 
 def main():
@@ -115,7 +117,7 @@ def main():
             cells = []
             for lo, hi in windows:
                 xs = [replay(rec, p, lo, hi, by_r) for rec in a.recordings]
-                cells.append(mean_se(xs) if None not in xs else "-")
+                cells.append(mean_se_text(xs) if None not in xs else "-")
             print(f"{'':<16} {p:>3} " + " ".join(c.rjust(12) for c in cells))
         print(f"{'a DEM run':<16}")
         for p in ps if by_r else [None]:
@@ -123,7 +125,7 @@ def main():
             for lo, hi in windows:
                 k_lo, k_hi = (max(lo * p, p + 1), hi * p) if by_r else (lo, hi)
                 xs = [dem_run(rec, k_lo, k_hi) for rec in a.recordings]
-                cells.append(mean_se(xs) if None not in xs and (not by_r or covered(p, lo, hi)) else "-")
+                cells.append(mean_se_text(xs) if None not in xs and (not by_r or covered(p, lo, hi)) else "-")
             print(f"{'':<16} {p if p else '':>3} " + " ".join(c.rjust(12) for c in cells))
 
 
