@@ -3,9 +3,11 @@
 (diagnostic, docs/validation.md#repetition-or-horizon)
 
 usage: repetition_windows.py --periods K [--recorded-periods 4,8,12,16] [--seeds 1,2,3,4]
-                             [--out DIR] REC.mcap [REC.mcap ...]
-       (each REC recorded with --recorded-periods at least the largest P, --reference K and
-       --twins 2 or more; `tdex` is target/release/tdex unless TDEX names another)
+                             [--tables DIR] [--out DIR] REC.mcap [REC.mcap ...]
+       (each REC recorded with --reference K and --twins 2 or more, and with --recorded-periods
+       at least the largest P, or a P beyond its own replayed from DIR/REC, a recording of the
+       same DEM run with more recorded periods and no reference; `tdex` is
+       target/release/tdex unless TDEX names another)
 
 By t_k a replay of P recorded periods has run each of them about r = k / P times. For each
 recording, each P and each path seed, the script extrapolates K periods
@@ -33,12 +35,23 @@ def tdex():
     return os.environ.get("TDEX", "target/release/tdex")
 
 
-def extrapolated(rec, periods, p, seed, out):
-    """The compare JSON's periods of one replay, extrapolating it first unless kept."""
+def recorded_periods(rec):
+    inspected = subprocess.run([tdex(), "inspect", rec, "--json"], check=True,
+                               capture_output=True, text=True).stdout
+    return json.loads(inspected)["recorded_periods"]
+
+
+def extrapolated(rec, periods, p, seed, out, tables):
+    """The compare JSON's periods of one replay, extrapolating it first unless kept. The
+    replay runs the recording's own tables, or with P beyond them those of its namesake in
+    `tables` (`tdex compare` judges a replay of another recording of the same DEM run)."""
     name = os.path.splitext(os.path.basename(rec))[0]
     path = os.path.join(out, f"p{p}_s{seed}_{name}.extra.mcap")
     if not os.path.exists(path):
-        subprocess.run([tdex(), "extrapolate", rec, "--recorded-periods", str(p), "--periods",
+        source = rec
+        if tables and p > recorded_periods(rec):
+            source = os.path.join(tables, os.path.basename(rec))
+        subprocess.run([tdex(), "extrapolate", source, "--recorded-periods", str(p), "--periods",
                         str(periods), "--seed", str(seed), "--threads", "1", "-o", path],
                        check=True, capture_output=True)
     compared = subprocess.run([tdex(), "compare", rec, path, "--json"], check=True,
@@ -64,6 +77,7 @@ def main():
     ap.add_argument("--periods", type=int, required=True)
     ap.add_argument("--recorded-periods", default="4,8,12,16")
     ap.add_argument("--seeds", default="1,2,3,4")
+    ap.add_argument("--tables", help="recordings of the same DEM runs with more recorded periods")
     ap.add_argument("--out", default="repetition")
     a = ap.parse_args()
     ps = [int(p) for p in a.recorded_periods.split(",")]
@@ -75,7 +89,7 @@ def main():
         for p in ps:
             ratio[rec, p] = []
             for seed in seeds:
-                for c in extrapolated(rec, a.periods, p, seed, a.out):
+                for c in extrapolated(rec, a.periods, p, seed, a.out, a.tables):
                     if c["k"] > p and c["ratio_to_floor"] is not None:
                         ratio[rec, p].append((c["k"], c["ratio_to_floor"]))
                     if c.get("dem_runs_ratio_to_others"):
