@@ -101,9 +101,15 @@ pub fn path_words(path: &RecurrencePath) -> String {
         let list: Vec<String> = t.iter().map(u32::to_string).collect();
         format!(", jumps only into periods {}", list.join(", "))
     });
+    let leave = path.leave_every.map_or(String::new(), |n| {
+        format!(
+            ", leaving after every {n} period{} in a row from where it stood",
+            if n == 1 { "" } else { "s" }
+        )
+    });
     format!(
-        "recorded periods 1 to {} (seed {}{targets}): {} jump{} in {k} period{}, {} periods \
-         between jumps on average",
+        "recorded periods 1 to {} (seed {}{targets}{leave}): {} jump{} in {k} period{}, {} \
+         periods between jumps on average",
         path.recorded_periods,
         path.seed,
         path.jumps(),
@@ -297,6 +303,7 @@ pub fn run(plan: &ExtrapolatePlan) -> Result<()> {
         recorded_periods: plan.recorded_periods,
         path_seed: plan.seed,
         jumps: plan.jumps.clone(),
+        leave: plan.leave,
         symmetry: plan.symmetry,
         boundary: plan.boundary,
     };

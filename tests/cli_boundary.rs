@@ -1,6 +1,7 @@
 //! `tdex extrapolate --boundary`: the fresh boundary maps conserve the heat over 500 periods,
 //! are the same bytes on any thread count and a function of the seed, say what they did, and
-//! work along a recurrence path; `--boundary exact` is the paper's method to the byte; the
+//! work along a recurrence path (also one leaving every few periods, `--jump-every`);
+//! `--boundary exact` is the paper's method to the byte; the
 //! fresh maps' options are refused without them, and a cap zone in a section without caps.
 
 use crate::cli_run::TINY_CASE;
@@ -364,4 +365,94 @@ fn a_cap_zone_is_refused_in_a_section_without_caps() {
     // without the zone the drift is moved round the section
     extrapolate(&run, &out_path, &flags);
     assert!(out_path.exists());
+}
+
+/// The jumps of an extrapolation's summary, `(end, start)` each once: where the replayed
+/// period is not the one after the period before (`t1` ends period 1).
+fn jumps_made(report: &serde_json::Value) -> std::collections::BTreeSet<(u64, u64)> {
+    let replayed = report["path"]["replayed"].as_array().unwrap();
+    let mut previous = 1;
+    let mut jumps = std::collections::BTreeSet::new();
+    for p in replayed.iter().map(|p| p.as_u64().unwrap()) {
+        if p != previous + 1 {
+            jumps.insert((previous, p - 1));
+        }
+        previous = p;
+    }
+    jumps
+}
+
+/// The `(end, start)` of each entry of `list` (the path's pairings, the fresh pools).
+fn ends_and_starts(list: &serde_json::Value) -> std::collections::BTreeSet<(u64, u64)> {
+    list.as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (p["end"].as_u64().unwrap(), p["start"].as_u64().unwrap()))
+        .collect()
+}
+
+/// `--jump-every N`: the path leaves the recording after every N periods in a row from the
+/// end of the period just replayed, through that end's pairing (or pool) with the start it
+/// enters; the heat is conserved over 500 periods and the bytes are the same on any thread
+/// count; with N of at least P the path is the default one; with `--jump-nearest` (starts
+/// ranked against the recording's end alone) it is refused.
+#[test]
+fn jumps_every_n_periods_leave_from_where_the_path_stands() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = recording(dir.path(), TINY_CASE, "4");
+    for kind in ["exact", "fresh-drift"] {
+        let mut files = Vec::new();
+        for threads in ["1", "2"] {
+            let out = dir.path().join(format!("every_{kind}{threads}.mcap"));
+            let report = extrapolate(
+                &run,
+                &out,
+                &[
+                    "--periods",
+                    "500",
+                    "--jump-every",
+                    "2",
+                    "--boundary",
+                    kind,
+                    "--threads",
+                    threads,
+                ],
+            );
+            assert_heat_conserved(&report, kind);
+            assert_eq!(report["path"]["leave_every"], 2);
+            let replayed = &report["path"]["replayed"];
+            // t1 ends period 1, period 2 follows, then the path leaves from t2
+            assert_eq!(replayed[0], 2);
+            assert_ne!(replayed[1], 3, "{replayed}");
+            let jumps = jumps_made(&report);
+            let ends: std::collections::BTreeSet<u64> = jumps.iter().map(|j| j.0).collect();
+            assert_eq!(ends, [2, 3, 4].into(), "stretches of 2 end at t2, t3, t4");
+            assert_eq!(ends_and_starts(&report["path"]["pairings"]), jumps);
+            if kind == "fresh-drift" {
+                assert_eq!(ends_and_starts(&report["fresh_pools"]), jumps);
+            }
+            files.push(std::fs::read(&out).unwrap());
+        }
+        assert!(files[0] == files[1], "{kind} depends on the threads");
+    }
+
+    let at_end = extrapolate(&run, &dir.path().join("end.mcap"), &["--periods", "40"]);
+    let every_4 = extrapolate(
+        &run,
+        &dir.path().join("every4.mcap"),
+        &["--periods", "40", "--jump-every", "4"],
+    );
+    assert_eq!(at_end["path"]["replayed"], every_4["path"]["replayed"]);
+    assert!(at_end["path"].get("leave_every").is_none());
+    assert!(jumps_made(&at_end).iter().all(|j| j.0 == 4));
+
+    let out = dir.path().join("refused.mcap");
+    let o = run_tdex(&extrapolate_args(
+        &run,
+        &out,
+        &["--periods", "2", "--jump-every", "2", "--jump-nearest", "2"],
+    ));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("cannot be used with"));
+    assert!(!out.exists());
 }

@@ -668,3 +668,52 @@ fn horizon_study_jumps_to_the_nearest_starts_when_asked() {
         "{md}"
     );
 }
+
+/// `tdex study horizon --jump-every N`: every path of the study leaves the recording after
+/// every N periods in a row from where it stands, as `tdex extrapolate --jump-every N` does,
+/// to the temperature, and the study says so.
+#[test]
+fn horizon_study_leaves_from_every_end_when_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let (_, out) = tiny_horizon_study(dir.path());
+    let rec = out.join("horizon.mcap");
+    let every = dir.path().join("every");
+    let study = horizon_from_recording(&rec, &["--jump-every", "1"], &every);
+    assert_eq!(study["jump_every"], 1);
+    let p2 = &study["runs"].as_array().unwrap()[1];
+    assert_eq!(p2["recorded_periods"], 2);
+    let studied = Path::new(p2["extrapolation"].as_str().unwrap());
+    let info = tdex_format::ExtrapolationReader::open(studied)
+        .unwrap()
+        .info()
+        .clone();
+    match info.roles {
+        tdex_format::extrapolation::Roles::Path(path) => {
+            assert_eq!(path.leave_every, Some(1));
+            // from t1 the only jump is into period 1 (period 2 is the continuation)
+            assert_eq!(path.replayed[0], 1, "{:?}", path.replayed);
+        }
+        other => panic!("{other:?}"),
+    }
+    let by_hand = dir.path().join("by_hand.mcap");
+    ok(&[
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "2",
+        "--periods",
+        &study["reference_periods"].to_string(),
+        "--jump-every",
+        "1",
+        "-o",
+        by_hand.to_str().unwrap(),
+    ]);
+    assert_eq!(temperatures(&by_hand), temperatures(studied));
+    let md = std::fs::read_to_string(every.join("study.md")).unwrap();
+    assert!(
+        md.contains("leaving the recording after every 1 period in a row"),
+        "{md}"
+    );
+    let plain = horizon_from_recording(&rec, &[], &dir.path().join("plain"));
+    assert!(plain.get("jump_every").is_none(), "{plain}");
+}

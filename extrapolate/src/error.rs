@@ -45,6 +45,18 @@ pub enum ExtrapolateError {
         target: u32,
         used: u32,
     },
+    /// Near starts asked of a path that leaves from every end: they are ranked by their
+    /// pairing with the recording's end `t_P'` alone.
+    #[error(
+        "{}: the starts nearest the recording's end are ranked by their pairing with t{used}, \
+         and a path leaving every {every} period(s) jumps from every recorded end",
+        recording.display()
+    )]
+    NearestLeavingEvery {
+        recording: PathBuf,
+        used: u32,
+        every: u32,
+    },
     /// The axial mirror asked of a recording whose geometry is not known to be symmetric.
     #[error(
         "{}: its case has no [drum], so its mid-plane y = 0 is not known to be a mirror \
@@ -87,6 +99,7 @@ impl Classify for ExtrapolateError {
             | ExtrapolateError::Refused { .. }
             | ExtrapolateError::RecordedPeriods { .. }
             | ExtrapolateError::JumpTarget { .. }
+            | ExtrapolateError::NearestLeavingEvery { .. }
             | ExtrapolateError::NoMirrorImage { .. }
             | ExtrapolateError::CapZoneWithoutCaps { .. }
             | ExtrapolateError::NoDrumAxis { .. } => Fault::Input,

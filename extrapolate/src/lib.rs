@@ -14,7 +14,7 @@ pub mod replay;
 
 pub use driver::{
     axial_period, extrapolate_recording, has_mirror_image, ExtrapolationOutcome,
-    ExtrapolationRequest, JumpStarts, MemoryLimit, MirrorCheck, Notice, TableChoice,
+    ExtrapolationRequest, JumpStarts, Leave, MemoryLimit, MirrorCheck, Notice, TableChoice,
 };
 pub use error::{fault_of, ExtrapolateError};
 /// The pairing sidecar's format lives with the other files in `tdex-format`.

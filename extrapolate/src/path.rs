@@ -11,32 +11,50 @@ pub enum Step {
     /// The recorded period after the one just replayed: the DEM's own continuation, the
     /// roles unchanged (no pairing).
     Continue { period: u32 },
-    /// From the end of the last recorded period to the start of `period`, through the
-    /// pairing of snapshot `t_P` to `t_{period − 1}`.
-    Jump { period: u32 },
+    /// From the end of recorded period `from` (the last one, `P`, unless the path leaves
+    /// every few periods) to the start of `period`, through the pairing of snapshot
+    /// `t_from` to `t_{period − 1}`.
+    Jump { from: u32, period: u32 },
+}
+
+/// Where the path leaves the recording for a jump.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Leave {
+    /// Only at the recording's end `t_P`: every stretch runs to the last recorded period,
+    /// which is then replayed at every jump (the paper's method extended to P periods).
+    #[default]
+    AtEnd,
+    /// After every `n` periods replayed in a row (or at `t_P`, sooner), from the end of the
+    /// period just replayed, as recurrence CFD leaves from the current state: every
+    /// recorded snapshot is an end, and no recorded period is replayed at every jump.
+    Every(std::num::NonZeroU32),
 }
 
 impl Step {
     /// The recorded period (1-based) replayed.
     pub fn period(self) -> u32 {
         match self {
-            Step::Continue { period } | Step::Jump { period } => period,
+            Step::Continue { period } | Step::Jump { period, .. } => period,
         }
     }
 }
 
 /// The path policy: start at `t1`, the end of recorded period 1; after period `p < P` go on
-/// with `p + 1`; after period `P` jump to the start of a period drawn uniformly from the jump
-/// targets (by default all of `1..=P`). A path is a function of `(P, targets, seed)` and the
-/// number of periods alone.
+/// with `p + 1`; after period `P` (or, leaving every `n`, after `n` periods in a row) jump to
+/// the start of a period drawn uniformly from the jump targets (by default all of `1..=P`)
+/// other than `p + 1`, the recording's own continuation. A path is a function of
+/// `(P, targets, leave, seed)` and the number of periods alone.
 #[derive(Debug, Clone)]
 pub struct RecurrencePolicy {
     recorded_periods: u32,
     /// The periods a jump may enter, distinct and ascending (`1..=P` unless restricted).
     targets: Vec<u32>,
+    leave: Leave,
     rng: Xoshiro256PlusPlus,
     /// The recorded period whose end the roles are at.
     at_end_of: u32,
+    /// Periods replayed since the path last jumped (period 1, from `t0`, counts).
+    in_a_row: u32,
 }
 
 impl RecurrencePolicy {
@@ -47,9 +65,17 @@ impl RecurrencePolicy {
         Self {
             recorded_periods,
             targets: (1..=recorded_periods).collect(),
+            leave: Leave::AtEnd,
             rng: Xoshiro256PlusPlus::seed_from_u64(seed),
             at_end_of: 1,
+            in_a_row: 1,
         }
+    }
+
+    /// The path that leaves the recording as `leave` says.
+    pub fn leaving(mut self, leave: Leave) -> Self {
+        self.leave = leave;
+        self
     }
 
     /// The path whose jumps enter only the periods `targets` (1-based; the caller checked
@@ -81,12 +107,30 @@ impl RecurrencePolicy {
     /// without the rejection loop that would make the number of draws depend on the values.
     /// One recorded period draws nothing: the paper's method uses no generator; nor does a
     /// single jump target.
-    fn draw_start(&mut self) -> u32 {
-        let n = self.targets.len() as u128;
-        if self.recorded_periods == 1 || n == 1 {
-            return self.targets[0];
+    ///
+    /// Leaving before `t_P`, the continuation `p + 1` is no jump and is not drawn; with no
+    /// other target the path goes on along the recording (`None`).
+    fn draw_start(&mut self) -> Option<u32> {
+        let next = self.at_end_of + 1;
+        let skip = self.targets.binary_search(&next).ok();
+        let n = (self.targets.len() - usize::from(skip.is_some())) as u128;
+        if n == 0 {
+            return None;
         }
-        self.targets[((u128::from(self.rng.next_u64()) * n) >> 64) as usize]
+        if self.recorded_periods == 1 || n == 1 {
+            return Some(self.targets[usize::from(skip == Some(0))]);
+        }
+        let drawn = ((u128::from(self.rng.next_u64()) * n) >> 64) as usize;
+        Some(self.targets[drawn + usize::from(skip.is_some_and(|at| drawn >= at))])
+    }
+
+    /// Whether the path leaves the recording after the period it has just replayed.
+    fn leaves_now(&self) -> bool {
+        self.at_end_of == self.recorded_periods
+            || match self.leave {
+                Leave::AtEnd => false,
+                Leave::Every(n) => self.in_a_row >= n.get(),
+            }
     }
 }
 
@@ -94,14 +138,23 @@ impl Iterator for RecurrencePolicy {
     type Item = Step;
 
     fn next(&mut self) -> Option<Step> {
-        let step = if self.at_end_of < self.recorded_periods {
-            Step::Continue {
-                period: self.at_end_of + 1,
-            }
+        let jump = if self.leaves_now() {
+            self.draw_start()
         } else {
-            Step::Jump {
-                period: self.draw_start(),
-            }
+            None
+        };
+        let step = match jump {
+            Some(period) => Step::Jump {
+                from: self.at_end_of,
+                period,
+            },
+            None => Step::Continue {
+                period: self.at_end_of + 1,
+            },
+        };
+        self.in_a_row = match step {
+            Step::Jump { .. } => 1,
+            Step::Continue { .. } => self.in_a_row + 1,
         };
         self.at_end_of = step.period();
         Some(step)
@@ -132,17 +185,25 @@ pub fn distinct_ascending(periods: &[u32]) -> Vec<u32> {
     periods
 }
 
-/// The starts (1-based periods) the path jumps to, each once, in increasing order: the
-/// pairings it needs.
-pub fn starts(steps: &[Step]) -> Vec<u32> {
-    let jumps: Vec<u32> = steps
+/// The jumps the path makes, each `(from, period)` once, in increasing order: the pairings
+/// it needs (of `t_from` to the start of `period`).
+pub fn jumps(steps: &[Step]) -> Vec<(u32, u32)> {
+    let mut jumps: Vec<(u32, u32)> = steps
         .iter()
-        .filter_map(|s| match s {
-            Step::Jump { period } => Some(*period),
+        .filter_map(|s| match *s {
+            Step::Jump { from, period } => Some((from, period)),
             Step::Continue { .. } => None,
         })
         .collect();
-    distinct_ascending(&jumps)
+    jumps.sort_unstable();
+    jumps.dedup();
+    jumps
+}
+
+/// The starts (1-based periods) the path jumps to, each once, in increasing order.
+pub fn starts(steps: &[Step]) -> Vec<u32> {
+    let starts: Vec<u32> = jumps(steps).iter().map(|&(_, period)| period).collect();
+    distinct_ascending(&starts)
 }
 
 #[cfg(test)]
@@ -156,7 +217,7 @@ mod tests {
     #[test]
     fn one_recorded_period_always_jumps_to_itself_without_drawing() {
         let steps = RecurrencePolicy::steps(1, 7, 5);
-        assert_eq!(steps, vec![Step::Jump { period: 1 }; 5]);
+        assert_eq!(steps, vec![Step::Jump { from: 1, period: 1 }; 5]);
         // the seed plays no part
         assert_eq!(RecurrencePolicy::steps(1, 8, 5), steps);
         assert_eq!(starts(&steps), [1]);
@@ -174,8 +235,12 @@ mod tests {
         for s in &steps {
             match *s {
                 Step::Continue { period } => assert_eq!(period, at_end_of + 1),
-                Step::Jump { period } => {
-                    assert_eq!(at_end_of, 3, "a jump only from the recording's end");
+                Step::Jump { from, period } => {
+                    assert_eq!(
+                        (from, at_end_of),
+                        (3, 3),
+                        "a jump only from the recording's end"
+                    );
                     assert!((1..=3).contains(&period));
                 }
             }
@@ -260,7 +325,7 @@ mod tests {
         let mut counts = [0u32; 5];
         let mut policy = RecurrencePolicy::new(p, 42);
         for s in policy.by_ref().take(n) {
-            if let Step::Jump { period } = s {
+            if let Step::Jump { period, .. } = s {
                 counts[period as usize - 1] += 1;
             }
         }
@@ -270,6 +335,93 @@ mod tests {
             // 5 standard deviations of a binomial count
             let sd = (expected * (1.0 - 1.0 / f64::from(p))).sqrt();
             assert!((f64::from(c) - expected).abs() < 5.0 * sd, "{counts:?}");
+        }
+    }
+
+    fn leaving_every(p: u32, n: u32, seed: u64, periods: usize) -> Vec<Step> {
+        let every = Leave::Every(std::num::NonZeroU32::new(n).expect("n > 0"));
+        RecurrencePolicy::new(p, seed)
+            .leaving(every)
+            .take(periods)
+            .collect()
+    }
+
+    #[test]
+    fn leaving_every_n_jumps_after_n_in_a_row_from_where_the_path_stands() {
+        let steps = leaving_every(8, 3, 5, 2000);
+        // t1 ends period 1, which counts: periods 2 and 3 follow, then a jump from t3
+        assert_eq!(
+            steps[..2],
+            [Step::Continue { period: 2 }, Step::Continue { period: 3 }]
+        );
+        assert!(matches!(steps[2], Step::Jump { from: 3, .. }));
+        let (mut at_end_of, mut in_a_row) = (1, 1);
+        for s in &steps {
+            match *s {
+                Step::Continue { period } => {
+                    assert_eq!(period, at_end_of + 1);
+                    assert!(in_a_row < 3, "no stretch longer than 3");
+                    in_a_row += 1;
+                }
+                Step::Jump { from, period } => {
+                    assert_eq!(from, at_end_of);
+                    assert!(
+                        in_a_row == 3 || from == 8,
+                        "a jump after 3 in a row or at t8"
+                    );
+                    assert_ne!(period, from + 1, "the continuation is no jump");
+                    in_a_row = 1;
+                }
+            }
+            at_end_of = s.period();
+        }
+        // jumps leave from every end a stretch of 3 reaches (t3 … t8) and enter every start
+        let jumps = jumps(&steps);
+        let mut ends: Vec<u32> = jumps.iter().map(|&(from, _)| from).collect();
+        ends.dedup();
+        assert_eq!(ends, (3..=8).collect::<Vec<_>>());
+        assert_eq!(starts(&steps), (1..=8).collect::<Vec<_>>());
+        // and every recorded period is replayed, none at every jump
+        let mut counts = [0u32; 8];
+        for s in &steps {
+            counts[s.period() as usize - 1] += 1;
+        }
+        assert!(counts.iter().all(|&c| c > 100), "{counts:?}");
+    }
+
+    #[test]
+    fn leaving_every_n_is_a_function_of_its_seed_and_n() {
+        let a = leaving_every(6, 2, 1, 300);
+        assert_eq!(leaving_every(6, 2, 1, 300), a);
+        assert_ne!(leaving_every(6, 2, 2, 300), a);
+        assert_ne!(leaving_every(6, 3, 1, 300), a);
+        // with n at least P the path leaves only at the end, draw for draw
+        assert_eq!(
+            leaving_every(6, 6, 1, 300),
+            RecurrencePolicy::steps(6, 1, 300)
+        );
+        assert_eq!(
+            leaving_every(6, 9, 1, 300),
+            RecurrencePolicy::steps(6, 1, 300)
+        );
+    }
+
+    #[test]
+    fn leaving_with_the_continuation_as_the_only_target_goes_on() {
+        // targets 2 and 3 of 3, leaving after every period: from t1 only 3 is a jump; from
+        // t2 only 2 (3 continues); from t3 either
+        let every = Leave::Every(std::num::NonZeroU32::MIN);
+        let steps: Vec<Step> = RecurrencePolicy::with_targets(3, 4, &[2, 3])
+            .leaving(every)
+            .take(300)
+            .collect();
+        assert_eq!(steps[0], Step::Jump { from: 1, period: 3 });
+        for (s, &before) in steps[1..].iter().zip(&steps) {
+            if let Step::Jump { from, period } = *s {
+                assert_eq!(from, before.period());
+                assert_ne!(period, from + 1);
+                assert!([2, 3].contains(&period));
+            }
         }
     }
 }

@@ -233,6 +233,18 @@ pub struct ExtrapolateArgs {
         value_parser = nearest_starts()
     )]
     pub jump_nearest: Option<std::num::NonZeroU32>,
+    /// Leave the recording after every N periods replayed in a row, from the end of the
+    /// period just replayed, instead of only at the recording's end: every recorded snapshot
+    /// is then an end the path jumps from (a pairing per jump made, stored beside the
+    /// recording), as recurrence CFD leaves from the current state, and the last recorded
+    /// period is no longer replayed at every jump (docs/method.md §6).
+    #[arg(
+        long = "jump-every",
+        value_name = "N",
+        conflicts_with = "jump_nearest",
+        value_parser = periods_in_a_row()
+    )]
+    pub jump_every: Option<std::num::NonZeroU32>,
     /// Use the drum's mirror symmetry (its mid-plane y = 0): every jump enters the mirror
     /// image of the recorded start, so the periods replayed alternate between the recording
     /// and its mirror image (docs/method.md §6). Costs one more pairing per start; needs a
@@ -692,6 +704,15 @@ pub struct HorizonStudyArgs {
     /// without it.
     #[arg(long = "jump-nearest", value_name = "K", value_parser = nearest_starts())]
     pub jump_nearest: Option<std::num::NonZeroU32>,
+    /// Every path leaves the recording after every N periods in a row, from where it stands
+    /// (`tdex extrapolate --jump-every`); a P of N periods or fewer leaves as without it.
+    #[arg(
+        long = "jump-every",
+        value_name = "N",
+        conflicts_with = "jump_nearest",
+        value_parser = periods_in_a_row()
+    )]
+    pub jump_every: Option<std::num::NonZeroU32>,
     /// Run every P twice: as the paper does, and with the drum's mirror image entered at
     /// every jump (`tdex extrapolate --mirror`, docs/method.md §6), so that the table says
     /// which of the two passes as one more DEM run on this case.
@@ -770,6 +791,17 @@ fn nearest_starts() -> impl clap::builder::TypedValueParser<Value = std::num::No
     use clap::builder::TypedValueParser;
     count::<u32>(1, "a whole number", "give at least 1 start to jump to")
         .try_map(std::num::NonZeroU32::try_from)
+}
+
+/// `tdex extrapolate --jump-every`: at least one period between jumps, so never zero.
+fn periods_in_a_row() -> impl clap::builder::TypedValueParser<Value = std::num::NonZeroU32> {
+    use clap::builder::TypedValueParser;
+    count::<u32>(
+        1,
+        "a whole number",
+        "replay at least 1 period between jumps",
+    )
+    .try_map(std::num::NonZeroU32::try_from)
 }
 
 /// `tdex extrapolate --boundary-pool`: at least one pairing.

@@ -197,6 +197,8 @@ pub struct ExtrapolatePlan {
     pub seed: Option<u64>,
     /// `--jump-to` or `--jump-nearest`: the starts a jump may enter.
     pub jumps: extrapolate::JumpStarts,
+    /// `--jump-every`: where the path leaves the recording for a jump.
+    pub leave: extrapolate::Leave,
     /// `--mirror`: the drum's mirror symmetry used at the jumps.
     pub symmetry: Symmetry,
     /// `--boundary` with its pool and cell width.
@@ -449,6 +451,9 @@ impl ExtrapolatePlan {
                 (None, Some(k)) => extrapolate::JumpStarts::Nearest(k),
                 (None, None) => extrapolate::JumpStarts::Every,
             },
+            leave: args
+                .jump_every
+                .map_or(extrapolate::Leave::AtEnd, extrapolate::Leave::Every),
             symmetry: if args.mirror {
                 Symmetry::AxialMirror
             } else {
@@ -989,6 +994,7 @@ impl StudyKind {
             tau_rev,
             seed,
             jump_nearest,
+            jump_every,
             mirror,
             boundary,
             fresh,
@@ -1066,6 +1072,7 @@ impl StudyKind {
                 extrapolate::JumpStarts::Every,
                 extrapolate::JumpStarts::Nearest,
             ),
+            leave: jump_every.map_or(extrapolate::Leave::AtEnd, extrapolate::Leave::Every),
         };
         Ok(StudyKind::Horizon {
             source,

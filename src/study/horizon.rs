@@ -21,7 +21,7 @@ use crate::compare::{self, Comparison, GroupMeans};
 use crate::extrapolation;
 use anyhow::{bail, Context, Result};
 use extrapolate::boundary::BoundaryMaps;
-use extrapolate::{ExtrapolationRequest, JumpStarts, MirrorCheck};
+use extrapolate::{ExtrapolationRequest, JumpStarts, Leave, MirrorCheck};
 use recorder::record;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -88,6 +88,10 @@ struct HorizonStudy {
     /// out without it: every start).
     #[serde(skip_serializing_if = "Option::is_none")]
     jump_nearest: Option<u32>,
+    /// `--jump-every N`: every path leaves the recording after every N periods in a row
+    /// (left out without it: at the recording's end only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    jump_every: Option<u32>,
     /// What each fresh boundary map of the runs redraws, in words (left out with the exact
     /// pairing alone): the settings every draw's runs share.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -216,6 +220,10 @@ pub fn run(
         jump_nearest: match jumps.starts {
             JumpStarts::Nearest(k) => Some(k.get()),
             JumpStarts::Every | JumpStarts::Listed(_) => None,
+        },
+        jump_every: match jumps.leave {
+            Leave::AtEnd => None,
+            Leave::Every(n) => Some(n.get()),
         },
         boundary_maps: boundaries
             .iter()
@@ -358,6 +366,7 @@ fn run_one(
         recorded_periods: Some(p),
         path_seed: jumps.seed,
         jumps: jumps.starts.clone(),
+        leave: jumps.leave,
         symmetry,
         boundary: maps,
         ..ExtrapolationRequest::new(
@@ -501,6 +510,9 @@ fn table(s: &HorizonStudy) -> String {
             "jumps: only into {} the end of the P used (the mean distance of the pairing)\n",
             nearest_starts(k)
         );
+    }
+    if let Some(n) = s.jump_every {
+        t += &format!("{}\n", leaving_every(n));
     }
     for e in &s.runs {
         t += &format!("{}: {}\n", e.label(), e.verdict);
@@ -709,7 +721,9 @@ fn markdown(s: &HorizonStudy, table: &str) -> String {
         s.jump_nearest.map_or(String::new(), |k| format!(
             "; jumps only into {} the end of the P used",
             nearest_starts(k)
-        )),
+        )) + &s
+            .jump_every
+            .map_or(String::new(), |n| format!("; {}", leaving_every(n))),
         s.reference_periods,
     )
 }
@@ -835,6 +849,14 @@ fn nearest_starts(k: u32) -> String {
     } else {
         format!("the {k} recorded periods whose starts are nearest")
     }
+}
+
+/// Where the paths leave the recording with `--jump-every n`, in words.
+fn leaving_every(n: u32) -> String {
+    format!(
+        "jumps: leaving the recording after every {n} period{} in a row, from where the path stands",
+        if n == 1 { "" } else { "s" }
+    )
 }
 
 #[cfg(test)]

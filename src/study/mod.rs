@@ -20,12 +20,13 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use tdex_format::{ExtrapolationReader, RecordingReader};
 
-/// How a horizon study's recurrence paths jump: their seed (`None`: the case's) and the
-/// starts they may enter.
+/// How a horizon study's recurrence paths jump: their seed (`None`: the case's), the
+/// starts they may enter and where they leave the recording.
 #[derive(Debug, Clone)]
 pub struct PathJumps {
     pub seed: Option<u64>,
     pub starts: extrapolate::JumpStarts,
+    pub leave: extrapolate::Leave,
 }
 
 pub fn run(plan: &StudyPlan) -> Result<()> {

@@ -11,6 +11,7 @@ mod run;
 pub use memory_limit::MemoryLimit;
 
 use crate::boundary::BoundaryMaps;
+pub use crate::path::Leave;
 use crate::replay::{MemoryPlan, Scheme};
 use crate::ExtrapolateError;
 use run::Extrapolation;
@@ -41,6 +42,9 @@ pub struct ExtrapolationRequest {
     pub path_seed: Option<u64>,
     /// The recorded starts a jump may enter.
     pub jumps: JumpStarts,
+    /// Where the path leaves the recording for a jump: at its end only, or every few
+    /// periods from where it stands.
+    pub leave: Leave,
     /// The drum's symmetry the jumps use: [`Symmetry::AxialMirror`] enters the mirror image
     /// of each start, alternating the recording and its image at every jump.
     pub symmetry: Symmetry,
@@ -70,6 +74,7 @@ impl ExtrapolationRequest {
             recorded_periods: None,
             path_seed: None,
             jumps: JumpStarts::Every,
+            leave: Leave::AtEnd,
             symmetry: Symmetry::None,
             boundary: BoundaryMaps::Exact,
         }

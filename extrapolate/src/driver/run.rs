@@ -3,7 +3,7 @@
 //! plan, the pairings, the tables, the replay written out, the outcome.
 
 use super::{
-    axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, JumpStarts,
+    axial_period, has_mirror_image, ExtrapolationOutcome, ExtrapolationRequest, JumpStarts, Leave,
     MirrorCheck, Notice, TableChoice,
 };
 use crate::boundary::{self, AxialEnds, BoundaryMaps, Pool, PoolDraws, Redraws};
@@ -23,9 +23,15 @@ use tdex_format::{
     Snapshot, FORMAT_VERSION,
 };
 
-/// A pairing the path needs: of the end snapshot `t_P'` to the start of recorded period
-/// `period` (snapshot `t_{period − 1}`).
+/// A jump of the path, `(from, period)`: from snapshot `t_from` into recorded period
+/// `period`.
+type Jump = (u32, u32);
+
+/// A pairing the path needs: of the end snapshot `t_from` (the recording's end `t_P'` unless
+/// the path leaves every few periods) to the start of recorded period `period` (snapshot
+/// `t_{period − 1}`).
 struct PathStart {
+    from: u32,
     period: u32,
     stored: StoredPairing,
 }
@@ -52,12 +58,13 @@ pub(super) struct Extrapolation<'a> {
     /// carries.
     snaps: Vec<Snapshot>,
     bodies: Bodies,
-    /// Each start the path enters, with its pairing if one is stored beside the recording.
-    found: Vec<(u32, Option<StoredPairing>)>,
+    /// Each jump the path makes, `(from, period)`, with its pairing if one is stored beside
+    /// the recording.
+    found: Vec<(Jump, Option<StoredPairing>)>,
     /// Rows of each recorded period used: the summary's counts (they size the memory
     /// estimate) until the tables are read, then the rows as decoded.
     rows_of: Vec<u64>,
-    /// The pairing of each start, reused or computed.
+    /// The pairing of each jump, reused or computed.
     pairings: Vec<PathStart>,
     /// With the axial mirror: each start's mirrored pairing beside its plain one.
     mirror_check: Vec<MirrorCheck>,
@@ -65,8 +72,8 @@ pub(super) struct Extrapolation<'a> {
     boundary: Boundary,
     /// What the fresh maps redraw (`None`: the exact map).
     redraws: Option<Redraws>,
-    /// With fresh boundary maps: each start's pool of pairings.
-    pools: Vec<(u32, Pool)>,
+    /// With fresh boundary maps: each jump's pool of pairings, by `(from, period)`.
+    pools: Vec<(Jump, Pool)>,
     /// Wall time of the pairings computed (and stored) by this run.
     seconds_pairing: f64,
     /// Whether every pairing of the path was found stored (the mirror check's aside).
@@ -123,6 +130,13 @@ impl<'a> Extrapolation<'a> {
                 cap_zone_diameters: refused.cap_zone_diameters,
             },
         )?;
+        if let (JumpStarts::Nearest(_), Leave::Every(every)) = (&request.jumps, request.leave) {
+            return Err(ExtrapolateError::NearestLeavingEvery {
+                recording: request.recording.clone(),
+                used,
+                every: every.get(),
+            });
+        }
         let seed = request.path_seed.unwrap_or_else(|| case_seed(&info));
         let snaps = (0..=used)
             .map(|index| cache::snapshot(&reader, index))
@@ -138,14 +152,15 @@ impl<'a> Extrapolation<'a> {
         };
         let steps: Vec<Step> =
             RecurrencePolicy::with_targets(used, seed, targets.as_deref().unwrap_or(&[]))
+                .leaving(request.leave)
                 .take(request.periods as usize)
                 .collect();
         // the paper's method pairs t1 to t0 even for no period (as it always has); a path
-        // pairs only the starts it jumps to
-        let starts = if used == 1 {
-            vec![1]
+        // pairs only the jumps it makes
+        let jumps = if used == 1 {
+            vec![(1, 1)]
         } else {
-            path::starts(&steps)
+            path::jumps(&steps)
         };
         let mirrored = path::mirrored(&steps, request.symmetry);
         let mut replayed = vec![used == 1; used as usize];
@@ -153,12 +168,13 @@ impl<'a> Extrapolation<'a> {
             replayed[s.period() as usize - 1] = true;
         }
         let bodies = Bodies::of(&info, &snaps[0]);
-        let end = &snaps[used as usize];
-        let found = starts
+        let found = jumps
             .iter()
-            .map(|&m| {
+            .map(|&(from, m)| {
                 let image = start_image(&snaps, m, request.symmetry);
-                (m, cache::load_image(&reader, &image, end, request.symmetry))
+                let end = &snaps[from as usize];
+                let stored = cache::load_image(&reader, &image, end, request.symmetry);
+                ((from, m), stored)
             })
             .collect();
         let rows_of = (1..=used).map(|p| period_rows(&reader, p)).collect();
@@ -233,15 +249,19 @@ impl<'a> Extrapolation<'a> {
     ) -> Result<(), ExtrapolateError> {
         let found = std::mem::take(&mut self.found);
         let mut pairings = Vec::with_capacity(found.len());
-        for (period, found) in found {
+        for ((from, period), found) in found {
             let stored = match found {
                 Some(stored) => stored,
                 None => {
                     self.pairing_reused = false;
-                    self.compute_and_store(period, self.request.symmetry, notice)?
+                    self.compute_and_store((from, period), self.request.symmetry, notice)?
                 }
             };
-            pairings.push(PathStart { period, stored });
+            pairings.push(PathStart {
+                from,
+                period,
+                stored,
+            });
         }
         self.pairings = pairings;
         if self.request.symmetry == Symmetry::AxialMirror {
@@ -251,22 +271,30 @@ impl<'a> Extrapolation<'a> {
         Ok(())
     }
 
-    /// Each start's pool of fresh pairings (none for the exact boundary), from the last
-    /// period used (`t_{P'−1}` to `t_P'`, the period every jump leaves), each start's maps
-    /// drawn from a seed of its own. Computed every run: a pool costs `pool` pairings, which
-    /// is small beside a DEM period, and storing it would write `pool` sidecars per start.
-    fn fresh_pools(&mut self) -> Result<Vec<(u32, Pool)>, ExtrapolateError> {
+    /// Each jump's pool of fresh pairings (none for the exact boundary), from the period the
+    /// jump leaves (`t_{from−1}` to `t_from`; `t_P'` ends it unless the path leaves every
+    /// few periods), each jump's maps drawn from a seed of its own. Computed every run: a
+    /// pool costs `pool` pairings, which is small beside a DEM period, and storing it would
+    /// write `pool` sidecars per jump.
+    fn fresh_pools(&mut self) -> Result<Vec<(Jump, Pool)>, ExtrapolateError> {
         let started = Instant::now();
-        let before = &self.snaps[self.used as usize - 1];
         let mut pools = Vec::new();
         let Some(redraws) = self.redraws else {
             return Ok(pools);
         };
         for p in &self.pairings {
             let start = start_image(&self.snaps, p.period, self.request.symmetry);
-            let seed = self.seed.wrapping_add(u64::from(p.period));
-            let pool = boundary::fresh_pool(redraws, before, self.end(), &start, seed)?;
-            pools.push((p.period, pool));
+            let (before, end) = (
+                &self.snaps[p.from as usize - 1],
+                &self.snaps[p.from as usize],
+            );
+            // from the recording's end the seed is the start's alone, as it has always been
+            let seed = self
+                .seed
+                .wrapping_add(u64::from(p.period))
+                .wrapping_add(u64::from(self.used - p.from) << 32);
+            let pool = boundary::fresh_pool(redraws, before, end, &start, seed)?;
+            pools.push(((p.from, p.period), pool));
         }
         self.seconds_pairing += started.elapsed().as_secs_f64();
         Ok(pools)
@@ -281,14 +309,14 @@ impl<'a> Extrapolation<'a> {
     ) -> Result<Vec<MirrorCheck>, ExtrapolateError> {
         let mut mirror_check = Vec::with_capacity(self.pairings.len());
         for at in 0..self.pairings.len() {
-            let period = self.pairings[at].period;
+            let (from, period) = (self.pairings[at].from, self.pairings[at].period);
             let start = &self.snaps[period as usize - 1];
-            let plain = match cache::load(&self.reader, start, self.end()) {
+            let plain = match cache::load(&self.reader, start, &self.snaps[from as usize]) {
                 Some(stored) => stored,
-                None => self.compute_and_store(period, Symmetry::None, notice)?,
+                None => self.compute_and_store((from, period), Symmetry::None, notice)?,
             };
             mirror_check.push(MirrorCheck::of(
-                self.used,
+                from,
                 period - 1,
                 &plain.summary,
                 &self.pairings[at].stored.summary,
@@ -297,11 +325,11 @@ impl<'a> Extrapolation<'a> {
         Ok(mirror_check)
     }
 
-    /// Computes and stores the pairing of the end snapshot to the start of recorded period
+    /// Computes and stores the pairing of snapshot `t_from` to the start of recorded period
     /// `period` (its image under `symmetry`), timed with the run's pairings.
     fn compute_and_store(
         &mut self,
-        period: u32,
+        (from, period): Jump,
         symmetry: Symmetry,
         notice: &mut impl FnMut(Notice<'_>),
     ) -> Result<StoredPairing, ExtrapolateError> {
@@ -311,7 +339,7 @@ impl<'a> Extrapolation<'a> {
             &self.reader,
             &self.info,
             self.request.reproducible,
-            (&start, self.end()),
+            (&start, &self.snaps[from as usize]),
             symmetry,
             notice,
         )?;
@@ -387,9 +415,9 @@ impl<'a> Extrapolation<'a> {
         let t = Instant::now();
         for ((k, step), &mirrored) in (1..=request.periods).zip(&self.steps).zip(&self.mirrored) {
             let p = step.period();
-            if let Step::Jump { period } = *step {
+            if let Step::Jump { from, period } = *step {
                 let drawn = draw_from_pool(self.boundary, &mut pool_draws);
-                let g = self.pairing_at_jump(period, drawn);
+                let g = self.pairing_at_jump((from, period), drawn);
                 temps.move_to_roles(g, &mut next)?;
                 replay::move_to_roles(&out.id, g, &mut next_id)?;
                 std::mem::swap(&mut out.id, &mut next_id);
@@ -431,23 +459,23 @@ impl<'a> Extrapolation<'a> {
         })
     }
 
-    /// The pairing a jump into recorded period `period` moves the roles along: of the
-    /// recording's end to that period's start (or its image), the exact one or the pool's
-    /// `drawn`.
-    fn pairing_at_jump(&self, period: u32, drawn: Option<usize>) -> &[u32] {
+    /// The pairing a jump from the end of recorded period `from` into recorded period
+    /// `period` moves the roles along: of `t_from` to that period's start (or its image),
+    /// the exact one or the pool's `drawn`.
+    fn pairing_at_jump(&self, jump: Jump, drawn: Option<usize>) -> &[u32] {
         match drawn {
             None => self
                 .pairings
                 .iter()
-                .find(|p| p.period == period)
+                .find(|p| (p.from, p.period) == jump)
                 .map(|p| &p.stored.g[..])
-                .expect("a pairing for every start of the path"),
+                .expect("a pairing for every jump of the path"),
             Some(m) => self
                 .pools
                 .iter()
-                .find(|(start, _)| *start == period)
+                .find(|(at, _)| *at == jump)
                 .map(|(_, pool)| &pool.maps[m][..])
-                .expect("a pool for every start of the path"),
+                .expect("a pool for every jump of the path"),
         }
     }
 
@@ -516,12 +544,16 @@ impl<'a> Extrapolation<'a> {
                 recorded_periods: self.used,
                 seed: self.seed,
                 jump_targets: self.targets.clone(),
+                leave_every: match self.request.leave {
+                    Leave::AtEnd => None,
+                    Leave::Every(n) => Some(n.get()),
+                },
                 replayed: self.steps.iter().map(|s| s.period()).collect(),
                 pairings: self
                     .pairings
                     .iter()
                     .map(|p| PathPairing {
-                        end: self.used,
+                        end: p.from,
                         start: p.period - 1,
                         summary: summary(&p.stored),
                     })
@@ -553,11 +585,6 @@ impl<'a> Extrapolation<'a> {
     /// Each start's pool of fresh pairings, told in the output and the outcome.
     fn fresh_pool_summaries(&self) -> Vec<tdex_format::extrapolation::FreshPool> {
         self.pools.iter().map(|(_, pool)| pool.summary).collect()
-    }
-
-    /// The recording's end `t_P'`, the snapshot every pairing of the path starts from.
-    fn end(&self) -> &Snapshot {
-        &self.snaps[self.used as usize]
     }
 
     /// The recorded periods replayed at least once, in order.

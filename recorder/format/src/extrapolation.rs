@@ -244,10 +244,15 @@ pub struct RecurrencePath {
     /// every recorded period used.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub jump_targets: Option<Vec<u32>>,
+    /// The path left the recording after every `n` periods replayed in a row, from the end
+    /// of the period just replayed (`--jump-every`); absent: at the recording's end only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub leave_every: Option<u32>,
     /// The recorded period (1-based) replayed at each extrapolated period `k = 1 … K`.
     pub replayed: Vec<u32>,
-    /// The pairing of each start the path jumped to, by start: snapshot `t_end` (`end` =
-    /// `P'`) paired to `t_start` (`start` = `m − 1` for a jump to period `m`).
+    /// The pairing of each jump the path made, by end and start: snapshot `t_end` (`end` =
+    /// `P'`, or with `leave_every` the end of the period the jump left) paired to `t_start`
+    /// (`start` = `m − 1` for a jump to period `m`).
     pub pairings: Vec<PathPairing>,
 }
 
@@ -528,6 +533,7 @@ mod tests {
                 recorded_periods: 3,
                 seed: 0,
                 jump_targets: None,
+                leave_every: None,
                 replayed,
                 pairings: Vec::new(),
             })
