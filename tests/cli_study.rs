@@ -610,6 +610,44 @@ fn horizon_study_runs_every_p_with_each_boundary_and_its_settings() {
     assert!(plain.get("boundary_maps").is_none(), "{plain}");
 }
 
+/// The study's P = 2 run (the second of `--recorded-periods 1,2`): its extrapolation and
+/// the recurrence path it followed.
+fn studied_path(
+    study: &serde_json::Value,
+) -> (PathBuf, tdex_format::extrapolation::RecurrencePath) {
+    let p2 = &study["runs"].as_array().unwrap()[1];
+    assert_eq!(p2["recorded_periods"], 2);
+    let studied = PathBuf::from(p2["extrapolation"].as_str().unwrap());
+    let info = tdex_format::ExtrapolationReader::open(&studied)
+        .unwrap()
+        .info()
+        .clone();
+    match info.roles {
+        tdex_format::extrapolation::Roles::Path(path) => (studied, path),
+        other => panic!("{other:?}"),
+    }
+}
+
+/// `tdex extrapolate REC --recorded-periods 2` over the study's reference periods with
+/// `flags`, beside the recording: the output's path.
+fn extrapolated_by_hand(rec: &Path, study: &serde_json::Value, flags: &[&str]) -> PathBuf {
+    let by_hand = rec.with_file_name("by_hand.mcap");
+    let periods = study["reference_periods"].to_string();
+    let mut args = vec![
+        "extrapolate",
+        rec.to_str().unwrap(),
+        "--recorded-periods",
+        "2",
+        "--periods",
+        &periods,
+        "-o",
+        by_hand.to_str().unwrap(),
+    ];
+    args.extend(flags);
+    ok(&args);
+    by_hand
+}
+
 /// `tdex study horizon --jump-nearest K`: every path of the study jumps only into the K
 /// starts nearest its end, as `tdex extrapolate --jump-nearest K` does, and the study says so.
 #[test]
@@ -635,33 +673,10 @@ fn horizon_study_jumps_to_the_nearest_starts_when_asked() {
     let near = dir.path().join("near");
     let study = horizon_from_recording(&rec, &["--jump-nearest", "1"], &near);
     assert_eq!(study["jump_nearest"], 1);
-    let p2 = &study["runs"].as_array().unwrap()[1];
-    assert_eq!(p2["recorded_periods"], 2);
-    let studied = Path::new(p2["extrapolation"].as_str().unwrap());
-    let info = tdex_format::ExtrapolationReader::open(studied)
-        .unwrap()
-        .info()
-        .clone();
-    match info.roles {
-        tdex_format::extrapolation::Roles::Path(path) => {
-            assert_eq!(path.jump_targets, Some(vec![nearest]))
-        }
-        other => panic!("{other:?}"),
-    }
-    let by_hand = dir.path().join("by_hand.mcap");
-    ok(&[
-        "extrapolate",
-        rec.to_str().unwrap(),
-        "--recorded-periods",
-        "2",
-        "--periods",
-        &study["reference_periods"].to_string(),
-        "--jump-to",
-        &nearest.to_string(),
-        "-o",
-        by_hand.to_str().unwrap(),
-    ]);
-    assert_eq!(temperatures(&by_hand), temperatures(studied));
+    let (studied, path) = studied_path(&study);
+    assert_eq!(path.jump_targets, Some(vec![nearest]));
+    let by_hand = extrapolated_by_hand(&rec, &study, &["--jump-to", &nearest.to_string()]);
+    assert_eq!(temperatures(&by_hand), temperatures(&studied));
     let md = std::fs::read_to_string(near.join("study.md")).unwrap();
     assert!(
         md.contains("jumps only into the recorded period whose start is nearest"),
@@ -680,35 +695,12 @@ fn horizon_study_leaves_from_every_end_when_asked() {
     let every = dir.path().join("every");
     let study = horizon_from_recording(&rec, &["--jump-every", "1"], &every);
     assert_eq!(study["jump_every"], 1);
-    let p2 = &study["runs"].as_array().unwrap()[1];
-    assert_eq!(p2["recorded_periods"], 2);
-    let studied = Path::new(p2["extrapolation"].as_str().unwrap());
-    let info = tdex_format::ExtrapolationReader::open(studied)
-        .unwrap()
-        .info()
-        .clone();
-    match info.roles {
-        tdex_format::extrapolation::Roles::Path(path) => {
-            assert_eq!(path.leave_every, Some(1));
-            // from t1 the only jump is into period 1 (period 2 is the continuation)
-            assert_eq!(path.replayed[0], 1, "{:?}", path.replayed);
-        }
-        other => panic!("{other:?}"),
-    }
-    let by_hand = dir.path().join("by_hand.mcap");
-    ok(&[
-        "extrapolate",
-        rec.to_str().unwrap(),
-        "--recorded-periods",
-        "2",
-        "--periods",
-        &study["reference_periods"].to_string(),
-        "--jump-every",
-        "1",
-        "-o",
-        by_hand.to_str().unwrap(),
-    ]);
-    assert_eq!(temperatures(&by_hand), temperatures(studied));
+    let (studied, path) = studied_path(&study);
+    assert_eq!(path.leave_every, Some(1));
+    // from t1 the only jump is into period 1 (period 2 is the continuation)
+    assert_eq!(path.replayed[0], 1, "{:?}", path.replayed);
+    let by_hand = extrapolated_by_hand(&rec, &study, &["--jump-every", "1"]);
+    assert_eq!(temperatures(&by_hand), temperatures(&studied));
     let md = std::fs::read_to_string(every.join("study.md")).unwrap();
     assert!(
         md.contains("leaving the recording after every 1 period in a row"),
