@@ -25,8 +25,9 @@ pub enum Leave {
     #[default]
     AtEnd,
     /// After every `n` periods replayed in a row (or at `t_P`, sooner), from the end of the
-    /// period just replayed, as recurrence CFD leaves from the current state: every
-    /// recorded snapshot is an end, and no recorded period is replayed at every jump.
+    /// period just replayed, as recurrence CFD leaves from the current state: the path
+    /// jumps from many recorded snapshots, and no recorded period is replayed before every
+    /// jump.
     Every(std::num::NonZeroU32),
 }
 

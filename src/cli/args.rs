@@ -234,10 +234,10 @@ pub struct ExtrapolateArgs {
     )]
     pub jump_nearest: Option<std::num::NonZeroU32>,
     /// Leave the recording after every N periods replayed in a row, from the end of the
-    /// period just replayed, instead of only at the recording's end: every recorded snapshot
-    /// is then an end the path jumps from (a pairing per jump made, stored beside the
-    /// recording), as recurrence CFD leaves from the current state, and the last recorded
-    /// period is no longer replayed at every jump (docs/method.md §6).
+    /// period just replayed, instead of only at the recording's end: the path then jumps from
+    /// many recorded snapshots, not one (a pairing per end and start it jumps along, stored
+    /// beside the recording), as recurrence CFD leaves from the current state, and the last
+    /// recorded period is no longer replayed before every jump (docs/method.md §6).
     #[arg(
         long = "jump-every",
         value_name = "N",
