@@ -1,14 +1,15 @@
 //! Several recorded periods replayed along a recurrence path, on synthetic
 //! recordings written with `RecordingWriter`: the identity through the recorded stretch, the
 //! path's seed, heat over 500 periods, `P' = 1` as the paper's method, the refusal of
-//! `P' > P`, streamed against in memory; the axial mirror's images and pairings.
+//! `P' > P`, streamed against in memory; the axial mirror's images and pairings; near starts
+//! refused on a path that leaves from every end.
 
 mod common;
 
 use extrapolate::replay::{self, Bodies, Exchanges, Scheme};
 use extrapolate::{
     extrapolate_recording, ExtrapolateError, ExtrapolationOutcome, ExtrapolationRequest,
-    MemoryLimit, TableChoice,
+    JumpStarts, Leave, MemoryLimit, TableChoice,
 };
 use rand_xoshiro::rand_core::{Rng as _, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
@@ -562,4 +563,35 @@ fn the_axial_mirror_is_refused_for_a_recording_without_a_drum() {
         "{text}"
     );
     assert!(!out.exists());
+}
+
+#[test]
+fn near_starts_are_refused_on_a_path_that_leaves_from_every_end() {
+    let dir = tempfile::tempdir().unwrap();
+    let rec = Synthetic::new(3, 5).write(&dir.path().join("run.mcap"), 3);
+    let mut req = request(&rec, &dir.path().join("x.mcap"), 6);
+    req.jumps = JumpStarts::Nearest(std::num::NonZeroU32::MIN);
+    req.leave = Leave::Every(std::num::NonZeroU32::MIN);
+    let e = extrapolate_recording(&req, |_| {}).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            ExtrapolateError::NearestLeavingEvery {
+                used: 3,
+                every: 1,
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert_eq!(extrapolate::fault_of(&e), Some(Fault::Input));
+    let text = e.to_string();
+    assert!(text.contains("run.mcap") && text.contains("t3"), "{text}");
+    assert!(!dir.path().join("x.mcap").exists());
+    // either alone is a path
+    req.leave = Leave::AtEnd;
+    run(&req);
+    req.jumps = JumpStarts::Every;
+    req.leave = Leave::Every(std::num::NonZeroU32::MIN);
+    run(&req);
 }
