@@ -201,15 +201,15 @@ pub fn jumps(steps: &[Step]) -> Vec<(u32, u32)> {
     jumps
 }
 
-/// The starts (1-based periods) the path jumps to, each once, in increasing order.
-pub fn starts(steps: &[Step]) -> Vec<u32> {
-    let starts: Vec<u32> = jumps(steps).iter().map(|&(_, period)| period).collect();
-    distinct_ascending(&starts)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The starts (1-based periods) the path jumps to, each once, in increasing order.
+    fn starts(steps: &[Step]) -> Vec<u32> {
+        let starts: Vec<u32> = jumps(steps).iter().map(|&(_, period)| period).collect();
+        distinct_ascending(&starts)
+    }
 
     fn periods(steps: &[Step]) -> Vec<u32> {
         steps.iter().map(|s| s.period()).collect()

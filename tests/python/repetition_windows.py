@@ -20,6 +20,7 @@ the recordings ± its standard error; beside them a DEM run in the seat (each DE
 median over the same t_k, judged against the other runs as the replay is, their mean).
 """
 import argparse
+import functools
 import json
 import os
 import statistics
@@ -35,6 +36,7 @@ def tdex():
     return os.environ.get("TDEX", "target/release/tdex")
 
 
+@functools.lru_cache(maxsize=None)
 def recorded_periods(rec):
     inspected = subprocess.run([tdex(), "inspect", rec, "--json"], check=True,
                                capture_output=True, text=True).stdout
